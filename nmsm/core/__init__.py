@@ -1,0 +1,1 @@
+"""Core: the generic optimization problem, term bases, plugin registry and back ends."""

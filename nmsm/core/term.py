@@ -1,0 +1,315 @@
+"""Cost and constraint terms: the normalized max-allowable-error formulation.
+
+A term is a frozen attrs class whose fields are its settings-XML elements. A subclass
+computes only its raw quantity; the base owns the normalization
+``(value - error_center) / max_allowable_error`` and hands the normalized values to the
+tool's reduction (``ctx.reduce_cost``), which applies the tool's scaling: means over
+samples (MTP, NCP, GCP, JMP, MTLI), duration-normalized time integrals (TO, VO, DO),
+term-type averaging, etc. The squared sum of the returned residuals is the term's
+contribution to the objective.
+
+Writing a term::
+
+    @attrs.frozen(kw_only=True)
+    class GeneralizedCoordinateTracking(ContinuousTerm):
+        \"\"\"Tracks one coordinate: q_exp - q (rad or m).\"\"\"
+        type: ClassVar[str] = "generalized_coordinate_tracking"
+        tools: ClassVar[frozenset[str]] = frozenset({"TO", "VO", "DO"})
+        coordinate: str
+
+        def bind(self, ctx):
+            ctx.require_coordinate(self, self.coordinate)
+
+        def quantity(self, ctx):
+            return ctx.tracked_coordinate(self.coordinate) - ctx.coordinate(self.coordinate)
+"""
+
+from __future__ import annotations
+
+import typing
+import warnings
+from collections.abc import Mapping
+from typing import Any, ClassVar, Protocol
+
+import attrs
+
+from nmsm.errors import InputError
+
+
+@attrs.frozen
+class SourceRef:
+    """Where a term was declared: settings file and line."""
+
+    file: str | None = None
+    line: int | None = None
+
+
+@attrs.frozen
+class TermSpec:
+    """A term as read from settings XML, before it is matched to a registered class.
+
+    ``fields`` maps each child element name to its text (stripped); ``type`` and
+    ``is_enabled`` are kept in ``fields`` too.
+    """
+
+    kind: str  # "cost" or "constraint"
+    type: str
+    fields: Mapping[str, str]
+    source: SourceRef = SourceRef()
+    field_lines: Mapping[str, int] = attrs.field(factory=dict)
+
+
+class TermContext(Protocol):
+    """What a tool hands to its terms. Tools add their own quantities (model outputs)."""
+
+    tool: str
+
+    def reduce_cost(self, term: CostTerm, normalized: Any) -> Any:
+        """Residual vector whose squared sum is the term's objective contribution."""
+
+    def reduce_constraint(self, term: ConstraintTerm, value: Any) -> tuple[Any, Any, Any]:
+        """``(expression, lower, upper)`` for the problem's constraint vector."""
+
+
+#: ``*_list`` settings elements split into one term per item (tools.md / catalog §1.1).
+LIST_TO_SINGULAR: dict[str, str] = {
+    "coordinate_list": "coordinate",
+    "load_list": "load",
+    "muscle_list": "muscle",
+    "force_list": "force",
+    "moment_list": "moment",
+    "marker_list": "marker",
+    "controller_list": "controller",
+    "body_list": "body",
+    "hindfoot_body_list": "hindfoot_body",
+    "synergy_list": "synergy",
+    "synergy_group_list": "synergy_group",
+    "axes": "axis",
+}
+
+_TRUE = {"true"}
+_FALSE = {"false"}
+
+
+def parse_bool(text: str, *, where: str = "value") -> bool:
+    low = text.strip().lower()
+    if low in _TRUE:
+        return True
+    if low in _FALSE or low == "":
+        return False
+    raise ValueError(f"{where} must be 'true' or 'false', got '{text}'")
+
+
+def _convert(text: str, annotation: Any) -> Any:
+    """Convert element text to the field's annotated type."""
+    origin = typing.get_origin(annotation)
+    args = typing.get_args(annotation)
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)):
+        inner = [a for a in args if a is not type(None)]
+        if text.strip() == "" and type(None) in args:
+            return None
+        return _convert(text, inner[0])
+    if annotation is bool:
+        return parse_bool(text)
+    if annotation is int:
+        return int(float(text))
+    if annotation is float:
+        return float(text)
+    if annotation is str:
+        return text.strip()
+    if origin in (tuple, list):
+        items = text.split()
+        item_type = args[0] if args else str
+        values = [_convert(i, item_type) for i in items]
+        return tuple(values) if origin is tuple else values
+    return text.strip()
+
+
+@attrs.frozen(kw_only=True)
+class Term:
+    """Base of cost and constraint terms.
+
+    Class attributes a subclass sets:
+      ``type``  the settings name (``<type>`` element);
+      ``tools`` the tool codes that accept it (see :data:`nmsm.core.registry.TOOL_NAMES`).
+    """
+
+    type: ClassVar[str] = ""
+    tools: ClassVar[frozenset[str]] = frozenset()
+    kind: ClassVar[str] = ""
+    #: settings element aliases: alias -> field name
+    aliases: ClassVar[dict[str, str]] = {}
+
+    is_enabled: bool = True
+    name: str | None = None
+    source: SourceRef = attrs.field(factory=SourceRef, eq=False, repr=False)
+
+    # ----- construction from settings -------------------------------------------------
+    @classmethod
+    def xml_fields(cls) -> dict[str, Any]:
+        """Settings element name -> annotated type, for every settable field."""
+        hints = typing.get_type_hints(cls)
+        return {f.name: hints[f.name] for f in attrs.fields(cls) if f.name not in ("source",)}
+
+    @classmethod
+    def from_spec(cls, spec: TermSpec) -> list[Term]:
+        """Instantiate from settings; a ``*_list`` element gives one term per item.
+
+        Unknown elements are errors naming the element and listing the valid ones.
+        """
+        fields = cls.xml_fields()
+        raw: dict[str, str] = {}
+        split_key: str | None = None
+        split_values: list[str] = []
+        for element, text in spec.fields.items():
+            if element in ("type",):
+                continue
+            target = cls.aliases.get(element, element)
+            singular = LIST_TO_SINGULAR.get(target)
+            if target not in fields and singular in fields:
+                split_key, split_values = singular, text.split()
+                if singular == "axis":  # "xyz", "x z" or "x,y": one term per named axis
+                    split_values = [c for c in text.lower() if c in "xyz"]
+                continue
+            if target not in fields:
+                raise InputError(
+                    f"element <{element}> is not a field of term type '{cls.type}'",
+                    file=spec.source.file,
+                    line=spec.field_lines.get(element, spec.source.line),
+                    element=f"<{spec.kind == 'cost' and 'RCNLCostTerm' or 'RCNLConstraintTerm'}>",
+                    expected="one of " + ", ".join(sorted(set(fields) - {"name"})),
+                )
+            raw[target] = text
+        values: dict[str, Any] = {}
+        for key, text in raw.items():
+            if text.strip() == "" and key in ("max_allowable_error", "error_center", "max_error", "min_error"):
+                warnings.warn(
+                    f"{spec.source.file}:{spec.field_lines.get(key, spec.source.line)}: empty <{key}> in "
+                    f"term '{cls.type}' treated as absent (default used)",
+                    stacklevel=2,
+                )
+                continue
+            try:
+                values[key] = _convert(text, fields[key])
+            except (TypeError, ValueError) as exc:
+                raise InputError(
+                    f"cannot read <{key}> = '{text}' of term '{cls.type}': {exc}",
+                    file=spec.source.file,
+                    line=spec.field_lines.get(key, spec.source.line),
+                    expected=f"{getattr(fields[key], '__name__', fields[key])}",
+                ) from exc
+        items = split_values if split_key else [None]
+        out: list[Term] = []
+        for item in items:
+            kw = dict(values)
+            if split_key:
+                kw[split_key] = item
+            try:
+                out.append(cls(source=spec.source, **kw))
+            except (TypeError, ValueError) as exc:
+                raise InputError(
+                    f"term '{cls.type}': {exc}",
+                    file=spec.source.file,
+                    line=spec.source.line,
+                    expected="the term's required elements: "
+                    + ", ".join(f.name for f in attrs.fields(cls) if f.default is attrs.NOTHING),
+                ) from exc
+        return out
+
+    # ----- binding and errors ------------------------------------------------------------
+    def bind(self, ctx: TermContext) -> None:
+        """Check names against the model and data once, before any solve. Override."""
+
+    def error(self, message: str, *, element: str | None = None, expected: str | None = None) -> InputError:
+        """An :class:`InputError` pointing at this term's declaration."""
+        label = f"term '{self.type}'" + (f" ({self.name})" if self.name else "")
+        return InputError(
+            f"{label}: {message}",
+            file=self.source.file,
+            line=self.source.line,
+            element=element,
+            expected=expected,
+        )
+
+    @property
+    def label(self) -> str:
+        """Short unique-ish label used in reports: type plus the selected component."""
+        parts = [self.type]
+        for key in ("coordinate", "load", "muscle", "force", "moment", "marker", "controller", "body",
+                    "hindfoot_body", "synergy", "synergy_group", "axis"):
+            value = getattr(self, key, None)
+            if value not in (None, ""):
+                parts.append(str(value))
+        return ":".join(parts)
+
+
+def _positive(instance: Any, attribute: attrs.Attribute, value: float) -> None:
+    if not value > 0:
+        raise ValueError(f"'{attribute.name}' must be > 0 (got {value})")
+
+
+@attrs.frozen(kw_only=True)
+class CostTerm(Term):
+    """A cost term: raw quantity -> ((value - error_center) / max_allowable_error)^2, reduced by the tool."""
+
+    kind: ClassVar[str] = "cost"
+
+    max_allowable_error: float = attrs.field(default=1.0, validator=_positive)
+    error_center: float = 0.0
+
+    def quantity(self, ctx: Any) -> Any:
+        """The raw quantity (CasADi expression or array). Override."""
+        raise NotImplementedError(f"{type(self).__name__}.quantity")
+
+    def normalized(self, ctx: Any) -> Any:
+        """``(quantity - error_center) / max_allowable_error``; override only for non-standard forms."""
+        return (self.quantity(ctx) - self.error_center) / self.max_allowable_error
+
+    def residuals(self, ctx: TermContext) -> Any:
+        """Residuals whose squared sum is this term's objective contribution."""
+        return ctx.reduce_cost(self, self.normalized(ctx))
+
+
+@attrs.frozen(kw_only=True)
+class ConstraintTerm(Term):
+    """A constraint term: ``min_error <= value <= max_error`` after the tool's scaling."""
+
+    kind: ClassVar[str] = "constraint"
+    aliases: ClassVar[dict[str, str]] = {"max_value": "max_error", "min_value": "min_error"}
+
+    max_error: float = 1.0
+    min_error: float = -1.0
+
+    def __attrs_post_init__(self) -> None:
+        if self.min_error > self.max_error:
+            raise ValueError(f"min_error {self.min_error} > max_error {self.max_error}")
+
+    def value(self, ctx: Any) -> Any:
+        """The constrained quantity (CasADi expression). Override."""
+        raise NotImplementedError(f"{type(self).__name__}.value")
+
+    def bounded(self, ctx: TermContext) -> tuple[Any, Any, Any]:
+        """``(expression, lower, upper)`` after the tool's scaling."""
+        return ctx.reduce_constraint(self, self.value(ctx))
+
+
+def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> list[Term]:
+    """Registered term instances for the enabled specs of ``tool``, in declaration order.
+
+    Unknown or disallowed type names raise :class:`InputError` naming the file and line.
+    """
+    from nmsm.core.registry import get_registry
+    from nmsm.errors import RegistryError
+
+    registry = registry or get_registry()
+    out: list[Term] = []
+    for spec in specs:
+        enabled = parse_bool(spec.fields.get("is_enabled", "false"))
+        if not enabled:
+            continue
+        try:
+            cls = registry.get(spec.kind, spec.type, tool)
+        except RegistryError as exc:
+            raise InputError(str(exc), file=spec.source.file, line=spec.source.line, element="<type>") from exc
+        out.extend(cls.from_spec(spec))
+    return out

@@ -1,0 +1,71 @@
+"""Exceptions raised by nmsm.
+
+Every error about user input names the file, the element or column, and what was
+expected, so a user can fix the input without reading nmsm's source.
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+
+class NmsmError(Exception):
+    """Base class of every error nmsm raises on purpose."""
+
+
+class InputError(NmsmError, ValueError):
+    """Bad user input: a settings file, a data table, a model or a name in them.
+
+    The message is assembled as ``FILE:LINE: <element>: message (expected ...)``
+    from the parts that are known.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | PathLike[str] | None = None,
+        line: int | None = None,
+        element: str | None = None,
+        expected: str | None = None,
+    ) -> None:
+        self.file = None if file is None else str(file)
+        self.line = line
+        self.element = element
+        self.expected = expected
+        self.detail = message
+        super().__init__(self._compose())
+
+    def _compose(self) -> str:
+        where = ""
+        if self.file:
+            where = self.file if self.line is None else f"{self.file}:{self.line}"
+            where += ": "
+        if self.element:
+            where += f"{self.element}: "
+        text = where + self.detail
+        if self.expected:
+            text += f" (expected {self.expected})"
+        return text
+
+
+class ModelError(InputError):
+    """An OpenSim model that nmsm cannot represent or that is inconsistent."""
+
+
+class RegistryError(NmsmError):
+    """A plugin problem: duplicate names, unknown names, bad registrations."""
+
+
+class SolverError(NmsmError):
+    """An optimization that failed; carries the path of the saved last iterate."""
+
+    def __init__(self, message: str, *, last_iterate_path: str | None = None) -> None:
+        self.last_iterate_path = last_iterate_path
+        if last_iterate_path:
+            message += f" (last iterate and diagnosis saved in {last_iterate_path})"
+        super().__init__(message)
+
+
+class BridgeError(NmsmError):
+    """An error reported by OpenSim running in the bridge's worker process."""

@@ -1,0 +1,179 @@
+"""Client side of the OpenSim bridge: a persistent worker process running OpenSim.
+
+OpenSim's Python wheel bundles its own CasADi, which clashes with ours in one process,
+so OpenSim runs only in a worker started as a fresh interpreter (never forked). The
+worker's current folder and ``opensim.log`` live in a private temporary folder, never in
+the user's or the shared data folders.
+
+Messages are pickled ``(command, kwargs)`` requests and ``(ok, result_or_error)`` replies
+over a pair of pipes; OpenSim's console output goes to the worker's log file.
+
+Environment:
+``NMSM_OPENSIM_PYTHON``  interpreter with ``opensim`` installed (default: this one).
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import pickle
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+from pathlib import Path
+from typing import Any, BinaryIO
+
+from nmsm.errors import BridgeError
+
+_HEADER = struct.Struct("<Q")
+
+
+def send_message(stream: BinaryIO, obj: Any) -> None:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(_HEADER.pack(len(data)))
+    stream.write(data)
+    stream.flush()
+
+
+def receive_message(stream: BinaryIO) -> Any:
+    header = stream.read(_HEADER.size)
+    if len(header) < _HEADER.size:
+        raise EOFError("bridge pipe closed")
+    (size,) = _HEADER.unpack(header)
+    chunks = []
+    remaining = size
+    while remaining:
+        chunk = stream.read(remaining)
+        if not chunk:
+            raise EOFError("bridge pipe closed mid-message")
+        chunks.append(chunk)
+        remaining -= len(chunk)
+    return pickle.loads(b"".join(chunks))
+
+
+def opensim_python() -> str:
+    return os.environ.get("NMSM_OPENSIM_PYTHON") or sys.executable
+
+
+def opensim_available() -> bool:
+    """True when the bridge's interpreter can import ``opensim`` (checked in a subprocess)."""
+    global _AVAILABLE
+    if _AVAILABLE is None:
+        try:
+            proc = subprocess.run(
+                [opensim_python(), "-c", "import opensim"],
+                capture_output=True, timeout=120, cwd=tempfile.gettempdir(),
+            )
+            _AVAILABLE = proc.returncode == 0
+        except (OSError, subprocess.TimeoutExpired):
+            _AVAILABLE = False
+    return _AVAILABLE
+
+
+_AVAILABLE: bool | None = None
+
+
+class OpenSimBridge:
+    """A running OpenSim worker. Use :func:`get_bridge` for the shared one.
+
+    >>> bridge = get_bridge()
+    >>> info = bridge.call("model_info", path="model.osim")
+    """
+
+    def __init__(self, python: str | None = None) -> None:
+        self.python = python or opensim_python()
+        self.workdir = Path(tempfile.mkdtemp(prefix="nmsm-opensim-"))
+        self.log_path = self.workdir / "worker.log"
+        self._lock = threading.Lock()
+        self._proc: subprocess.Popen[bytes] | None = None
+        self._start()
+
+    def _start(self) -> None:
+        req_r, req_w = os.pipe()
+        rep_r, rep_w = os.pipe()
+        env = dict(os.environ)
+        package_root = str(Path(__file__).resolve().parents[2])
+        env["PYTHONPATH"] = package_root + os.pathsep + env.get("PYTHONPATH", "")
+        env["NMSM_BRIDGE_WORKDIR"] = str(self.workdir)
+        log = open(self.log_path, "ab")
+        try:
+            self._proc = subprocess.Popen(
+                [self.python, "-m", "nmsm.opensim_bridge._opensim_worker", str(req_r), str(rep_w)],
+                stdin=subprocess.DEVNULL, stdout=log, stderr=log, cwd=self.workdir, env=env,
+                pass_fds=(req_r, rep_w), close_fds=True,
+            )
+        finally:
+            log.close()
+            os.close(req_r)
+            os.close(rep_w)
+        self._requests = os.fdopen(req_w, "wb")
+        self._replies = os.fdopen(rep_r, "rb")
+        ok, payload = self._exchange(("ping", {}))
+        if not ok:
+            raise BridgeError(f"OpenSim worker failed to start: {payload}")
+
+    def _log_tail(self, n: int = 30) -> str:
+        try:
+            lines = self.log_path.read_text(errors="replace").splitlines()
+        except OSError:
+            return ""
+        return "\n".join(lines[-n:])
+
+    def _exchange(self, message: tuple[str, dict[str, Any]]) -> tuple[bool, Any]:
+        try:
+            send_message(self._requests, message)
+            return receive_message(self._replies)
+        except (EOFError, BrokenPipeError, OSError) as exc:
+            code = self._proc.poll() if self._proc else None
+            raise BridgeError(
+                f"OpenSim worker ({self.python}) stopped (exit code {code}) during '{message[0]}': {exc}. "
+                f"Is the 'opensim' package installed (pip install opensim)? Worker log tail:\n{self._log_tail()}"
+            ) from exc
+
+    def call(self, command: str, **kwargs: Any) -> Any:
+        """Run a worker command (see :mod:`nmsm.opensim_bridge.commands`); OpenSim errors raise BridgeError."""
+        with self._lock:
+            if self._proc is None or self._proc.poll() is not None:
+                self._start()
+            ok, payload = self._exchange((command, kwargs))
+        if not ok:
+            raise BridgeError(f"OpenSim ({command}): {payload}")
+        return payload
+
+    def close(self) -> None:
+        with self._lock:
+            if self._proc is not None and self._proc.poll() is None:
+                try:
+                    send_message(self._requests, ("shutdown", {}))
+                    self._proc.wait(timeout=10)
+                except (OSError, subprocess.TimeoutExpired):
+                    self._proc.kill()
+            for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
+                try:
+                    if stream:
+                        stream.close()
+                except OSError:
+                    pass
+            self._proc = None
+        shutil.rmtree(self.workdir, ignore_errors=True)
+
+    def __enter__(self) -> OpenSimBridge:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+_BRIDGE: OpenSimBridge | None = None
+
+
+def get_bridge() -> OpenSimBridge:
+    """The process-wide worker (started on first use, closed at exit)."""
+    global _BRIDGE
+    if _BRIDGE is None:
+        _BRIDGE = OpenSimBridge()
+        atexit.register(_BRIDGE.close)
+    return _BRIDGE

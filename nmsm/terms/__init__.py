@@ -1,0 +1,16 @@
+"""Built-in terms (one module per term or family), registered via the ``nmsm`` entry point.
+
+Adding a module with a ``CostTerm`` subclass (with a non-empty ``type``) here is all
+it takes to register it.
+"""
+
+from __future__ import annotations
+
+from nmsm.core.term import CostTerm
+from nmsm.core.registry import classes_in_package
+from nmsm.hookspecs import hookimpl
+
+
+@hookimpl
+def nmsm_cost_terms() -> list[type]:
+    return classes_in_package(__name__, CostTerm)

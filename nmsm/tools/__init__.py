@@ -1,0 +1,1 @@
+"""The tools: one folder each (jmp, mtp, ncp, gcp, treatment, preprocess, surrogate, pipeline)."""

@@ -1,0 +1,45 @@
+"""``nmsm run SETTINGS.xml``: find the tool element and hand the file to that tool."""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import Any
+
+from nmsm.errors import InputError
+
+#: settings tool element -> "module:function" taking (settings_path, **options)
+TOOL_RUNNERS: dict[str, str] = {
+    "JointModelPersonalizationTool": "nmsm.tools.jmp.run:run_settings",
+    "MuscleTendonPersonalizationTool": "nmsm.tools.mtp.run:run_settings",
+    "NeuralControlPersonalizationTool": "nmsm.tools.ncp.run:run_settings",
+    "GroundContactPersonalizationTool": "nmsm.tools.gcp.run:run_settings",
+    "TrackingOptimizationTool": "nmsm.tools.treatment.run:run_settings",
+    "VerificationOptimizationTool": "nmsm.tools.treatment.run:run_settings",
+    "DesignOptimizationTool": "nmsm.tools.treatment.run:run_settings",
+}
+
+
+def tool_element_name(settings_file: str | Path) -> str:
+    """The tool element of a settings file (old schemas upgraded first)."""
+    from nmsm.io.settings.document import read_settings_document
+
+    doc = read_settings_document(settings_file)
+    return doc.tool_element.tag
+
+
+def run_settings_file(settings_file: str | Path, **options: Any) -> Any:
+    tag = tool_element_name(settings_file)
+    target = TOOL_RUNNERS.get(tag)
+    if target is None:
+        raise InputError(
+            f"unknown tool element <{tag}>",
+            file=settings_file,
+            expected="one of " + ", ".join(f"<{t}>" for t in TOOL_RUNNERS),
+        )
+    module_name, func_name = target.split(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        raise InputError(f"tool <{tag}> is not available in this version of nmsm ({exc})", file=settings_file) from exc
+    return getattr(module, func_name)(Path(settings_file), **options)

@@ -1,0 +1,51 @@
+"""Shared fixtures.
+
+``shared_data``  path of ``../shared/data`` (or ``$NMSM_SHARED_DATA``). Tests that use it
+                 skip when it is absent, and fail instead when ``NMSM_REQUIRE_SHARED_DATA=1``
+                 (set by ``.ci/run``).
+``bridge``       the OpenSim worker; skips when ``opensim`` is not installed, fails instead
+                 when ``NMSM_REQUIRE_OPENSIM=1``.
+
+Never import opensim here or in any test module: OpenSim runs only in the bridge's worker.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _shared_data_dir() -> Path:
+    env = os.environ.get("NMSM_SHARED_DATA")
+    return Path(env) if env else REPO.parent / "shared" / "data"
+
+
+def _require(flag: str) -> bool:
+    return os.environ.get(flag, "") not in ("", "0", "false", "no")
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    path = _shared_data_dir()
+    if not (path / "README.md").is_file():
+        message = f"shared data not found at {path} (set NMSM_SHARED_DATA)"
+        if _require("NMSM_REQUIRE_SHARED_DATA"):
+            pytest.fail(message + "; NMSM_REQUIRE_SHARED_DATA is set, so this is an error")
+        pytest.skip(message)
+    return path
+
+
+@pytest.fixture(scope="session")
+def bridge():
+    from nmsm.opensim_bridge import get_bridge, opensim_available
+
+    if not opensim_available():
+        message = "the 'opensim' package is not installed for the bridge (pip install opensim)"
+        if _require("NMSM_REQUIRE_OPENSIM"):
+            pytest.fail(message + "; NMSM_REQUIRE_OPENSIM is set, so this is an error")
+        pytest.skip(message)
+    return get_bridge()

@@ -1,0 +1,93 @@
+"""The CostTerm base: normalized formula, reductions, settings conversion and errors."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import attrs
+import numpy as np
+import pytest
+
+from nmsm.core import reductions
+from nmsm.core.term import ConstraintTerm, CostTerm, SourceRef, TermSpec
+from nmsm.errors import InputError
+
+
+@attrs.frozen(kw_only=True)
+class _Offsets(CostTerm):
+    """Test term: the raw quantity is a fixed array."""
+
+    type: ClassVar[str] = "offsets"
+    tools: ClassVar[frozenset[str]] = frozenset({"MTP"})
+    coordinate: str = ""
+    values: tuple[float, ...] = ()
+
+    def quantity(self, ctx):
+        return np.asarray(self.values)
+
+
+class _MeanSquareContext:
+    tool = "MTP"
+
+    def reduce_cost(self, term, z):
+        return reductions.mean_square(z)
+
+    def reduce_constraint(self, term, value):
+        return value, term.min_error, term.max_error
+
+
+def test_normalized_cost_matches_hand_computation() -> None:
+    term = _Offsets(values=(1.0, 3.0, -2.0), error_center=1.0, max_allowable_error=2.0)
+    r = term.residuals(_MeanSquareContext())
+    # z = (x - 1)/2 = [0, 1, -1.5]; mean of squares = (0 + 1 + 2.25)/3
+    assert float(np.sum(r**2)) == pytest.approx(3.25 / 3)
+
+
+def test_quadrature_reduction() -> None:
+    r = reductions.quadrature(np.array([1.0, 2.0]), np.array([0.25, 0.75]))
+    assert float(np.sum(r**2)) == pytest.approx(0.25 * 1 + 0.75 * 4)
+
+
+def test_from_spec_converts_and_splits_lists() -> None:
+    spec = TermSpec(
+        "cost", "offsets",
+        {"is_enabled": "true", "max_allowable_error": "2.5", "coordinate_list": "knee ankle", "values": "1 2"},
+        SourceRef("s.xml", 7),
+    )
+    terms = _Offsets.from_spec(spec)
+    assert [t.coordinate for t in terms] == ["knee", "ankle"]
+    assert terms[0].max_allowable_error == 2.5 and terms[0].values == (1.0, 2.0)
+    assert terms[0].source == SourceRef("s.xml", 7)
+
+
+def test_from_spec_unknown_element_names_file_line_and_valid_fields() -> None:
+    spec = TermSpec("cost", "offsets", {"is_enabled": "true", "colour": "red"}, SourceRef("s.xml", 12), {"colour": 14})
+    with pytest.raises(InputError) as info:
+        _Offsets.from_spec(spec)
+    text = str(info.value)
+    assert "s.xml:14" in text and "<colour>" in text and "max_allowable_error" in text
+
+
+def test_zero_max_allowable_error_rejected() -> None:
+    spec = TermSpec("cost", "offsets", {"max_allowable_error": "0"}, SourceRef("s.xml", 3))
+    with pytest.raises(InputError, match="must be > 0"):
+        _Offsets.from_spec(spec)
+
+
+def test_empty_max_allowable_error_treated_as_absent() -> None:
+    spec = TermSpec("cost", "offsets", {"max_allowable_error": ""}, SourceRef("s.xml", 3))
+    with pytest.warns(UserWarning, match="treated as absent"):
+        (term,) = _Offsets.from_spec(spec)
+    assert term.max_allowable_error == 1.0
+
+
+def test_constraint_aliases_and_order() -> None:
+    @attrs.frozen(kw_only=True)
+    class _C(ConstraintTerm):
+        type: ClassVar[str] = "c"
+        tools: ClassVar[frozenset[str]] = frozenset({"TO"})
+
+    (c,) = _C.from_spec(TermSpec("constraint", "c", {"max_value": "2", "min_value": "-3"}))
+    assert (c.min_error, c.max_error) == (-3.0, 2.0)
+    with pytest.raises(InputError, match="min_error"):
+        _C.from_spec(TermSpec("constraint", "c", {"max_error": "-2", "min_error": "3"}))
