@@ -1,25 +1,124 @@
 """Base classes of the two non-term plugin kinds: controllers and model modifiers.
 
-Their full interface is defined with Treatment Optimization (``nmsm.tools.treatment``);
-here they only carry what the registry needs: a settings name (``type``) and the tools
-that accept them.
+Both are used by Treatment Optimization (``nmsm.tools.treatment``, TO/VO/DO). A plugin
+subclasses one of them, sets ``type`` (its settings name) and ``tools``, and is returned
+by the ``nmsm_controllers`` / ``nmsm_model_modifiers`` hook of a module named in the
+``nmsm`` entry-point group (nmsm's own built-ins live in ``nmsm/controllers/`` and
+``nmsm/modifiers/``).
+
+Controller life cycle (the treatment tool calls, in order)::
+
+    c = Cls.from_settings(element_settings, setup)   # read data, check names (no CasADi yet)
+    c.control_specs()                                # controls added to the phase
+    c.declare(problem)                               # static design variables (synergy weights)
+    c.applied_loads(view), c.muscle_activations(view), ...   # symbolic, per grid, lazily
+    c.output_tables(solution_view)                   # files written after the solve
+
+``view`` is a :class:`nmsm.tools.treatment.context.GridView`: the controller reads its own
+controls with ``view.control(name)`` and the kinematics with ``view.positions()`` etc.
+
+Model modifier (Design Optimization ``<model_functions>``)::
+
+    m = Cls(name, settings_file)                     # one per name listed
+    m.apply(target, parameters)                      # before the problem is built
+
+``target`` is a :class:`nmsm.tools.treatment.modifiers.ModificationTarget`: it exposes the
+controllers' muscle parameters, synergy activation scales, the contact model's belt speed,
+as symbolic values a modifier replaces by expressions of the static ``parameters``
+(``{type: MX}`` from ``<RCNLParameterTermSet>``).
 """
 
 from __future__ import annotations
 
-from typing import ClassVar
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import attrs
+import numpy as np
+
+if TYPE_CHECKING:  # CasADi is not imported here: the OpenSim worker imports nmsm.core
+    import casadi as cs
+
+
+@attrs.define
+class ControlSpec:
+    """One control a controller adds to the phase.
+
+    ``name``: internal, unique column name (e.g. ``torque:knee_angle_r``); ``aliases``:
+    names users write in ``<controller_list>`` (``knee_angle_r``, ``knee_angle_r_moment``);
+    ``label``: column label in the output files. ``lower``/``upper``: bounds (controller
+    units); ``guess``: (K,) values at the collocation points; ``scale``/``offset``: variable
+    scaling (default: from finite bounds).
+    """
+
+    name: str
+    label: str
+    lower: float
+    upper: float
+    guess: np.ndarray
+    aliases: tuple[str, ...] = ()
+    scale: float | None = None
+    offset: float | None = None
 
 
 class Controller:
     """How a Treatment Optimization problem actuates the model (torque, synergy, ...).
 
     ``type`` is the controller's name; ``settings_element`` the XML element that selects
-    it (e.g. ``RCNLTorqueController``).
+    it (e.g. ``RCNLTorqueController``). Subclasses override the methods below; the defaults
+    describe a controller with no controls, no muscles and no applied loads.
     """
 
     type: ClassVar[str] = ""
     tools: ClassVar[frozenset[str]] = frozenset({"TO", "VO", "DO"})
     settings_element: ClassVar[str] = ""
+
+    @classmethod
+    def from_settings(cls, settings: Any, setup: Any) -> Controller:
+        """Build from the element's parsed settings and the tool's
+        :class:`nmsm.tools.treatment.controller_setup.ControllerSetup`."""
+        raise NotImplementedError(f"{cls.__name__}.from_settings")
+
+    # ---- declaration -------------------------------------------------------------------
+    def control_specs(self) -> Sequence[ControlSpec]:
+        """Controls added to the phase (after the joint accelerations), in order."""
+        return ()
+
+    def declare(self, problem: Any) -> None:
+        """Declare static design variables in the OptimizationProblem (e.g. synergy weights)."""
+
+    def controlled_coordinates(self) -> tuple[str, ...]:
+        """Coordinates on which this controller applies loads."""
+        return ()
+
+    # ---- symbolic quantities (per grid view) ------------------------------------------------
+    def applied_loads(self, view: Any) -> Mapping[str, cs.MX]:
+        """Generalized forces applied on coordinates: coordinate -> (n, 1) MX, N·m or N."""
+        return {}
+
+    def muscle_names(self) -> tuple[str, ...]:
+        """Muscles whose activations this controller determines."""
+        return ()
+
+    def muscle_activations(self, view: Any) -> cs.MX:
+        """(n, M) activations of :meth:`muscle_names` on the view's grid."""
+        raise NotImplementedError(f"{type(self).__name__} drives no muscles")
+
+    def muscle_quantity(self, view: Any, name: str) -> cs.MX | None:
+        """(n, M) muscle quantity such as ``normalized_fiber_length``; None if not modeled."""
+        return None
+
+    def control_reference(self, name: str, times: np.ndarray) -> np.ndarray:
+        """(n, 1) initial-guess reference of control ``name`` (internal name) at times (s)
+        on the reference time base (for ``controller_tracking``)."""
+        raise KeyError(f"{type(self).__name__} has no reference for control '{name}'")
+
+    # ---- outputs -------------------------------------------------------------------------
+    def output_tables(self, solution: Any) -> Mapping[str, tuple[Sequence[str], np.ndarray]]:
+        """Files to write: file name -> (column labels, (n, k) values) on the output grid.
+
+        ``solution`` is a :class:`nmsm.tools.treatment.solution.TreatmentSolution`."""
+        return {}
 
 
 class ModelModifier:
@@ -30,3 +129,11 @@ class ModelModifier:
 
     type: ClassVar[str] = ""
     tools: ClassVar[frozenset[str]] = frozenset({"DO"})
+
+    def __init__(self, name: str = "", settings_file: str | None = None) -> None:
+        self.name = name or self.type
+        self.settings_file = settings_file
+
+    def apply(self, target: Any, parameters: Mapping[str, Any]) -> None:
+        """Replace quantities of ``target`` by expressions of ``parameters``. Override."""
+        raise NotImplementedError(f"{type(self).__name__}.apply")

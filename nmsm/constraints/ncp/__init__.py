@@ -1,0 +1,1 @@
+"""Neural Control Personalization (NCP) constraints."""

@@ -1,0 +1,1 @@
+"""Treatment Optimization constraint terms (TO, VO, DO): one module per family."""

@@ -1,0 +1,1 @@
+"""Small synthetic models and data generated in code (tests, examples)."""

@@ -1,0 +1,99 @@
+"""Find a trial's files in a data folder by its prefix.
+
+The original matches prefixes as substrings, so ``gait_1`` also matches ``gait_10``. Here
+an exact stem match wins (``gait_1.sto``); a substring match is used only when exactly one
+entry contains the prefix; several candidates are an error listing them.
+
+Layout (tools.md §0.2): ``<data>/IKData/<prefix>.sto``, ``IDData/``, ``EMGData/``,
+``GRFData/``, ``MAData/<prefix>/<prefix>_..._Length.sto`` etc.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from nmsm.errors import InputError
+
+#: extensions of OpenSim tables
+TABLE_EXTENSIONS = (".sto", ".mot")
+
+
+def _entries(directory: Path, *, folders: bool, extensions: Sequence[str]) -> list[Path]:
+    if not directory.is_dir():
+        raise InputError(f"folder not found: {directory}", file=directory, expected="an existing data folder")
+    out = []
+    for entry in sorted(directory.iterdir()):
+        if entry.name.startswith("."):
+            continue
+        if folders and entry.is_dir():
+            out.append(entry)
+        elif not folders and entry.is_file() and entry.suffix.lower() in extensions:
+            out.append(entry)
+    return out
+
+
+def trial_prefixes(directory: str | os.PathLike[str], extensions: Sequence[str] = TABLE_EXTENSIONS) -> list[str]:
+    """Trial prefixes found in ``directory``: table file names without extension, sorted."""
+    return [p.stem for p in _entries(Path(directory), folders=False, extensions=tuple(e.lower() for e in extensions))]
+
+
+def _match(candidates: list[Path], prefix: str, key, directory: Path, what: str) -> Path:
+    exact = [p for p in candidates if key(p) == prefix]
+    if len(exact) == 1:
+        return exact[0]
+    if len(exact) > 1:
+        raise InputError(
+            f"several {what}s named '{prefix}': {', '.join(p.name for p in exact)}",
+            file=directory,
+            expected=f"one {what} per trial",
+        )
+    containing = [p for p in candidates if prefix in p.name]
+    if len(containing) == 1:
+        return containing[0]
+    if not containing:
+        names = ", ".join(p.name for p in candidates) or "(empty folder)"
+        raise InputError(
+            f"no {what} for trial '{prefix}' (found: {names})",
+            file=directory,
+            expected=f"a {what} whose name is, or contains, '{prefix}'",
+        )
+    raise InputError(
+        f"trial '{prefix}' is ambiguous: {', '.join(p.name for p in containing)} all contain it",
+        file=directory,
+        expected=f"a {what} named exactly '{prefix}', or a prefix contained in one name only",
+    )
+
+
+def find_trial_file(
+    directory: str | os.PathLike[str], prefix: str, *, extensions: Sequence[str] = TABLE_EXTENSIONS
+) -> Path:
+    """The table of trial ``prefix`` in ``directory`` (exact stem, else unique substring)."""
+    directory = Path(directory)
+    exts = tuple(e.lower() for e in extensions)
+    return _match(_entries(directory, folders=False, extensions=exts), prefix, lambda p: p.stem, directory, "file")
+
+
+def find_trial_folder(directory: str | os.PathLike[str], prefix: str) -> Path:
+    """The sub-folder of trial ``prefix`` in ``directory`` (e.g. ``MAData/<prefix>``)."""
+    directory = Path(directory)
+    return _match(_entries(directory, folders=True, extensions=()), prefix, lambda p: p.name, directory, "folder")
+
+
+def find_file_by_suffix(
+    directory: str | os.PathLike[str], suffix: str, *, extensions: Sequence[str] = TABLE_EXTENSIONS
+) -> Path:
+    """The one table in ``directory`` whose stem ends with ``suffix`` (e.g. ``_Length``, ``_MomentArm_knee_angle_r``)."""
+    directory = Path(directory)
+    exts = tuple(e.lower() for e in extensions)
+    found = [p for p in _entries(directory, folders=False, extensions=exts) if p.stem.endswith(suffix)]
+    if len(found) == 1:
+        return found[0]
+    if not found:
+        raise InputError(f"no file ending in '{suffix}'", file=directory, expected=f"a table named '*{suffix}.sto'")
+    raise InputError(
+        f"several files end in '{suffix}': {', '.join(p.name for p in found)}",
+        file=directory,
+        expected=f"one table named '*{suffix}.sto'",
+    )

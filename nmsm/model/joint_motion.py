@@ -1,0 +1,173 @@
+"""The motion a joint allows, as CasADi SX functions of its own coordinates.
+
+For a joint with ``k`` coordinates, :func:`joint_motion_function` returns an SX Function
+
+    (q_j[k], u_j[k], s) -> (R_FM[3x3], p_FM[3], H_w[3xk], H_v[3xk], c_w[3], c_v[3])
+
+* ``R_FM``, ``p_FM``: pose of the child frame M in the parent frame F (p in F, m).
+* ``H_w``, ``H_v``: angular velocity of M in F and velocity of M's origin in F, both
+  expressed in F, per unit generalized speed: ``w = H_w u``, ``v = H_v u``.
+* ``c_w``, ``c_v``: the velocity-product terms: ``dw/dt = H_w udot + c_w`` (F-frame
+  derivatives), likewise for ``v``.
+* ``s``: the uniform scale factor of the parent frame's base body; it multiplies the
+  translation functions of a CustomJoint other than pure coordinate axes (LinearFunction
+  1, 0), as OpenSim's scaling does. (OpenSim multiplies by ``dot(axis, factors)``, which
+  flips axes pointing in a negative direction; nmsm uses ``s``, the length scaling.)
+
+Generalized speeds ``u`` equal the coordinate rates except for the rotational
+coordinates of FreeJoint and BallJoint, whose speeds are OpenSim's: the angular
+velocity of M in F expressed in F.
+"""
+
+from __future__ import annotations
+
+import casadi as cs
+import numpy as np
+
+from nmsm.errors import ModelError
+from nmsm.model.components import Joint
+from nmsm.model.functions import LinearFunction
+from nmsm.model.spatial import axis_angle, body_xyz, vee
+
+_X = np.array([1.0, 0.0, 0.0])
+_Y = np.array([0.0, 1.0, 0.0])
+_Z = np.array([0.0, 0.0, 1.0])
+
+#: joints whose rotational speeds are angular velocities (not Euler-angle rates)
+ANGULAR_VELOCITY_JOINTS = ("FreeJoint", "BallJoint")
+
+
+def _custom_pose(joint: Joint, q: cs.SX, s: cs.SX, coordinate_index: dict[str, int]) -> tuple[cs.SX, cs.SX]:
+    rotation = cs.SX.eye(3)
+    translation = cs.SX.zeros(3, 1)
+    for index, axis in enumerate(joint.transform_axes):
+        if axis.coordinates:
+            value = axis.function(q[coordinate_index[axis.coordinates[0]]])
+        else:
+            value = axis.function(0.0)
+        if index < 3:
+            rotation = cs.mtimes(rotation, axis_angle(axis.axis, value))
+        else:
+            direction = np.asarray(axis.axis, dtype=float)
+            unit = direction / np.linalg.norm(direction)
+            f = axis.function
+            is_dof = isinstance(f, LinearFunction) and f.slope == 1.0 and f.intercept == 0.0
+            if not is_dof:
+                value = value * s
+            translation = translation + value * cs.DM(unit)
+    return rotation, translation
+
+
+def joint_pose(joint: Joint, q: cs.SX, s: cs.SX) -> tuple[cs.SX, cs.SX]:
+    """``(R_FM, p_FM)`` of ``joint`` at its coordinates ``q`` (SX, length k)."""
+    t = joint.type
+    zero = cs.SX.zeros(3, 1)
+    if t == "CustomJoint":
+        return _custom_pose(joint, q, s, {name: i for i, name in enumerate(joint.coordinates)})
+    if t == "WeldJoint":
+        return cs.SX.eye(3), zero
+    if t == "PinJoint":
+        return axis_angle(_Z, q[0]), zero
+    if t == "SliderJoint":
+        return cs.SX.eye(3), cs.vertcat(q[0], 0, 0)
+    if t == "UniversalJoint":
+        return cs.mtimes(axis_angle(_X, q[0]), axis_angle(_Y, q[1])), zero
+    if t in ("GimbalJoint", "BallJoint"):
+        return body_xyz(q[0:3]), zero
+    if t == "PlanarJoint":
+        return axis_angle(_Z, q[0]), cs.vertcat(q[1], q[2], 0)
+    if t == "FreeJoint":
+        return body_xyz(q[0:3]), q[3:6]
+    raise ModelError(f"joint type '{t}' is not supported", element=f"{t} '{joint.name}'")
+
+
+def _custom_simbody_motion(joint: Joint, q: cs.SX, u: cs.SX, s: cs.SX) -> tuple[cs.SX, ...]:
+    """``(H_w, H_v, c_w, c_v)`` of a CustomJoint as Simbody's FunctionBased mobilizer
+    computes them: the angular velocity is exact (``w = W theta_dot`` with
+    ``W = [a1, R1 a2, R1 R2 a3]``), but the rate of ``W`` uses the angular velocities of
+    the first mobility alone and of all mobilities except the third, which is exact only
+    when mobility i drives rotation axis i."""
+    k = len(joint.coordinates)
+    index = {name: i for i, name in enumerate(joint.coordinates)}
+    fq = cs.SX.zeros(6, k)  # d(axis value)/dq
+    second = cs.SX.zeros(6, 1)  # f'' u_c^2 per axis
+    angles = []
+    x = cs.SX.sym("x")
+    for i, axis in enumerate(joint.transform_axes):
+        factor = 1.0
+        if i >= 3:
+            f = axis.function
+            is_dof = isinstance(f, LinearFunction) and f.slope == 1.0 and f.intercept == 0.0
+            factor = 1.0 if is_dof else s
+        if axis.coordinates:
+            c = index[axis.coordinates[0]]
+            value = axis.function(x)
+            d1 = cs.gradient(value, x)
+            d2 = cs.gradient(d1, x)
+            fun = cs.Function("axis", [x], [value, d1, d2])
+            val, der, der2 = fun(q[c])
+            fq[i, c] = der * factor
+            second[i] = der2 * factor * u[c] ** 2
+        else:
+            val = axis.function(0.0)
+        angles.append(val)
+    units = [np.asarray(a.axis, dtype=float) / np.linalg.norm(a.axis) for a in joint.transform_axes]
+    r1 = axis_angle(units[0], angles[0])
+    r2 = cs.mtimes(r1, axis_angle(units[1], angles[1]))
+    w_cols = [cs.DM(units[0]), cs.mtimes(r1, cs.DM(units[1])), cs.mtimes(r2, cs.DM(units[2]))]
+    w_mat = cs.horzcat(*w_cols)
+    a_trans = cs.horzcat(*[cs.DM(units[i]) for i in (3, 4, 5)])
+    h_w = cs.mtimes(w_mat, fq[0:3, :])
+    h_v = cs.mtimes(a_trans, fq[3:6, :])
+    u1 = cs.vertcat(u[0], cs.SX.zeros(k - 1, 1)) if k > 1 else u
+    u2 = cs.vertcat(u[0:2], 0, u[3:]) if k > 2 else u
+    v1 = cs.mtimes(h_w, u1)
+    v2 = cs.mtimes(h_w, u2)
+    w_rate = cs.horzcat(cs.SX.zeros(3, 1), cs.cross(v1, w_cols[1]), cs.cross(v2, w_cols[2]))
+    c_w = cs.mtimes(w_rate, cs.mtimes(fq[0:3, :], u)) + cs.mtimes(w_mat, second[0:3])
+    c_v = cs.mtimes(a_trans, second[3:6])
+    return h_w, h_v, c_w, c_v
+
+
+def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> cs.Function:
+    """The SX Function described in the module docstring, for ``joint``.
+
+    ``custom_joint_bias``: ``"opensim"`` computes a CustomJoint's velocity-product terms as
+    Simbody does (see :func:`_custom_simbody_motion`; matches OpenSim's inverse dynamics),
+    ``"exact"`` differentiates the joint's kinematics exactly. They differ only for
+    CustomJoints in which one coordinate drives several rotation axes (the RCNL knee).
+    """
+    if custom_joint_bias not in ("opensim", "exact"):
+        raise ValueError(f"custom_joint_bias must be 'opensim' or 'exact', not '{custom_joint_bias}'")
+    k = len(joint.coordinates)
+    q = cs.SX.sym("q", k)
+    u = cs.SX.sym("u", k)
+    s = cs.SX.sym("s")
+    rotation, translation = joint_pose(joint, q, s)
+    if joint.type in ANGULAR_VELOCITY_JOINTS:
+        h_w = cs.SX.zeros(3, k)
+        h_w[:, 0:3] = cs.SX.eye(3)
+        c_w = cs.SX.zeros(3, 1)
+        h_v = cs.SX.zeros(3, k)
+        if k == 6:
+            h_v[:, 3:6] = cs.SX.eye(3)
+        c_v = cs.SX.zeros(3, 1)
+    elif k and joint.type == "CustomJoint" and custom_joint_bias == "opensim":
+        h_w, h_v, c_w, c_v = _custom_simbody_motion(joint, q, u, s)
+    elif k:
+        rotation_rate = cs.jtimes(rotation, q, u)
+        w = vee(cs.mtimes(rotation_rate, rotation.T))
+        v = cs.jtimes(translation, q, u)
+        h_w = cs.jacobian(w, u)
+        h_v = cs.jacobian(v, u)
+        c_w = cs.jtimes(w, q, u)
+        c_v = cs.jtimes(v, q, u)
+    else:
+        h_w = cs.SX.zeros(3, 0)
+        h_v = cs.SX.zeros(3, 0)
+        c_w = cs.SX.zeros(3, 1)
+        c_v = cs.SX.zeros(3, 1)
+    return cs.Function(
+        f"motion_{joint.name}", [q, u, s], [rotation, translation, h_w, h_v, c_w, c_v],
+        ["q", "u", "s"], ["R", "p", "H_w", "H_v", "c_w", "c_v"],
+    )

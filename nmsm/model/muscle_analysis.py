@@ -1,0 +1,256 @@
+"""Muscle Analysis: muscle-tendon lengths, velocities and moment arms along a motion.
+
+The equivalent of OpenSim's MuscleAnalysis for the NMSM data layout
+(``MAData/<trial>/<trial>_Length.sto``, ``_Velocity.sto``, ``_MomentArm_<coord>.sto``,
+OpenSim's MuscleAnalysis header: name line, ``version=1``, ``nRows``, ``nColumns``,
+``inDegrees=no``, description, ``endheader``).
+
+Poses: the motion's coordinate columns (rotational ones converted from degrees when the
+file says ``inDegrees=yes``), unlisted coordinates at their default values, dependent
+coordinates of couplers from their coupler (what OpenSim's ``Model.assemble`` does).
+Coordinate speeds: derivative of an interpolating quintic spline with natural end
+conditions (third and fourth derivatives zero at the ends) through each independent
+coordinate, the spline OpenSim's AnalyzeTool differentiates (GCV spline, error variance
+0); fewer than 6 frames use ``numpy.gradient``.
+
+Quantities (SI): length L (m); velocity ``V = Σ_c dL/dq_c q̇_c`` (m/s) over independent
+coordinates, total derivatives through couplers; moment arm ``r_c = −dL/dq_c`` (m). For a
+dependent (coupled) coordinate the file holds the moment arm of its independent
+coordinate, as OpenSim's ``computeMomentArm`` reports it there.
+
+Engines (how the geometry is computed):
+
+``"nmsm"``     exact path-point geometry in CasADi (:mod:`nmsm.model.muscle_paths`) for
+               muscles without active wrapping; wrapping muscles from ``surrogate``
+               (an error when it lacks one).
+``"opensim"``  every muscle through the OpenSim bridge: path lengths, and central
+               differences of them (coupler assembled) for the derivatives.
+``"auto"``     (default) ``nmsm`` for path-point muscles; wrapping muscles from the
+               surrogate when given, else from OpenSim.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import attrs
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+from nmsm.errors import InputError, ModelError
+from nmsm.io.storage import Table, read_storage, write_storage
+
+ENGINES = ("auto", "nmsm", "opensim")
+
+#: description lines of OpenSim's MuscleAnalysis files
+_DESCRIPTION = (
+    "",
+    "This analysis gathers basic information about muscles during a simulation (e.g., forces, tendon lengths, moment arms, etc).",
+    "Units are S.I. units (second, meters, Newtons, ...)",
+    "If the header above contains a line with 'inDegrees', this indicates whether rotational values are in degrees (yes) or radians (no).",
+    "",
+)
+
+
+@attrs.frozen(eq=False)
+class MuscleAnalysisResult:
+    """Geometry along a motion.
+
+    ``time`` ``(n,)`` s; ``lengths``, ``velocities`` ``(n, n_m)`` (m, m/s);
+    ``moment_arms`` ``(n, n_m, n_c)`` m over ``coordinates``; ``sources`` maps each muscle
+    to how it was computed (``"path"``, ``"surrogate"``, ``"opensim"``).
+    """
+
+    time: np.ndarray
+    muscles: tuple[str, ...]
+    coordinates: tuple[str, ...]
+    lengths: np.ndarray
+    velocities: np.ndarray
+    moment_arms: np.ndarray
+    sources: dict[str, str] = attrs.field(factory=dict)
+
+    def table(self, quantity: str) -> Table:
+        """``"Length"``, ``"Velocity"`` or ``"MomentArm_<coordinate>"`` as a Table."""
+        if quantity == "Length":
+            data = self.lengths
+        elif quantity == "Velocity":
+            data = self.velocities
+        elif quantity.startswith("MomentArm_") and quantity[len("MomentArm_"):] in self.coordinates:
+            data = self.moment_arms[:, :, self.coordinates.index(quantity[len("MomentArm_"):])]
+        else:
+            raise KeyError(f"unknown quantity '{quantity}'")
+        return Table(time=self.time, labels=self.muscles, data=data, name=quantity, comments=_DESCRIPTION)
+
+    def write(self, directory: str | os.PathLike[str], trial: str) -> list[Path]:
+        """Write ``<directory>/<trial>/<trial>_Length.sto``, ``_Velocity.sto`` and one
+        ``_MomentArm_<coord>.sto`` per coordinate; returns the paths."""
+        folder = Path(directory) / trial
+        folder.mkdir(parents=True, exist_ok=True)
+        quantities = ["Length", "Velocity"] + [f"MomentArm_{c}" for c in self.coordinates]
+        return [write_storage(folder / f"{trial}_{q}.sto", self.table(q), name=q) for q in quantities]
+
+
+# ---- poses --------------------------------------------------------------------------------
+def motion_poses(model: Any, motion: Table) -> np.ndarray:
+    """All model coordinates ``(n, n_q)`` (model order, rad/m) from a motion table.
+
+    ``model`` is a parsed :class:`~nmsm.model.components.Model`. Rotational columns are
+    converted when the file is in degrees; missing coordinates take default values;
+    dependent coordinates are set by their couplers.
+    """
+    names = model.coordinate_names
+    rotational = {c.name for c in model.coordinates if c.is_rotational}
+    table = motion.to_radians(rotational)
+    q = np.tile([c.default_value for c in model.coordinates], (table.n_rows, 1)).astype(float)
+    present = [n for n in names if table.has(n)]
+    if not present:
+        raise InputError(
+            "no column names a coordinate of the model",
+            file=motion.source,
+            line=motion.label_line,
+            element="column labels",
+            expected=f"coordinate names of {model.name} ({', '.join(names[:6])}, ...)",
+        )
+    for name in present:
+        q[:, names.index(name)] = table.column(name)
+    return couple_numeric(model, q)
+
+
+def couple_numeric(model: Any, q: np.ndarray) -> np.ndarray:
+    """``q`` ``(n, n_q)`` with dependent coordinates set by their couplers (numpy)."""
+    q = np.array(q, dtype=float)
+    names = model.coordinate_names
+    couplers = list(model.coupled_coordinates.values())
+    for _ in range(len(couplers)):
+        for c in couplers:
+            if len(c.independent) != 1:
+                raise ModelError(f"coupler with {len(c.independent)} independent coordinates is not supported",
+                                 file=model.file, element=f"CoordinateCouplerConstraint '{c.name}'",
+                                 expected="one independent coordinate")
+            x = q[:, names.index(c.independent[0])]
+            q[:, names.index(c.dependent)] = c.scale_factor * c.function.numeric(x, 0)
+    return q
+
+
+def coordinate_speeds(time: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``dq/dt`` ``(n, k)`` of ``q`` ``(n, k)`` sampled at ``time`` ``(n,)`` (see module docstring)."""
+    time = np.asarray(time, dtype=float)
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    if len(time) < 2:
+        return np.zeros_like(q)
+    if len(time) < 6:
+        return np.gradient(q, time, axis=0)
+    natural = ([(3, 0.0), (4, 0.0)], [(3, 0.0), (4, 0.0)])
+    spline = make_interp_spline(time, q, k=5, bc_type=natural)
+    return spline.derivative()(time)
+
+
+# ---- engines ------------------------------------------------------------------------------
+def _opensim_geometry(model_file: Path, model: Any, q: np.ndarray, muscles: Sequence[str], independent: Sequence[str],
+                      bridge: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Lengths ``(n, m)`` and total gradients ``(n, m, len(independent))`` from OpenSim."""
+    if bridge is None:
+        from nmsm.opensim_bridge import get_bridge
+
+        bridge = get_bridge()
+    out = bridge.call("muscle_length_gradients", model=str(model_file), q=q, coordinates=model.coordinate_names,
+                      muscles=list(muscles), wrt=list(independent))
+    return out["lengths"], out["gradient"]
+
+
+def _nmsm_geometry(model: Any, q: np.ndarray, muscles: Sequence[str], independent: Sequence[str],
+                   surrogate: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Lengths and total gradients from exact paths and the surrogate (:class:`MuscleGeometry`)."""
+    from nmsm.model.muscle_geometry import MuscleGeometry
+    from nmsm.model.muscle_paths import evaluate_function
+
+    geometry = MuscleGeometry(model, muscles, independent, surrogate=surrogate)
+    lengths, _, arms = evaluate_function(geometry.function(), q)
+    return lengths, -arms
+
+
+def _load_model(path: Path) -> Any:
+    from nmsm.model import load_model
+
+    return load_model(path)
+
+
+def analyze_motion(
+    model_file: str | os.PathLike[str],
+    motion: Table | str | os.PathLike[str],
+    *,
+    muscles: Sequence[str] | None = None,
+    coordinates: Sequence[str] | None = None,
+    engine: str = "auto",
+    surrogate: Any | None = None,
+    bridge: Any | None = None,
+    model: Any | None = None,
+) -> MuscleAnalysisResult:
+    """Lengths, velocities and moment arms of ``muscles`` along ``motion``.
+
+    ``coordinates``: moment-arm coordinates (default: every model coordinate, as
+    MuscleAnalysis with ``all``). ``surrogate``: a
+    :class:`~nmsm.model.surrogate.SurrogateModel` for wrapping muscles. ``model``: the
+    parsed model, when the caller has it.
+    """
+    if engine not in ENGINES:
+        raise InputError(f"unknown engine '{engine}'", element="engine", expected=" or ".join(ENGINES))
+    model_file = Path(model_file)
+    model = model if model is not None else _load_model(model_file)
+    table = motion if isinstance(motion, Table) else read_storage(motion)
+    names = model.coordinate_names
+    muscles = tuple(model.muscle_names if muscles is None else muscles)
+    for m in muscles:
+        model.muscle(m)  # KeyError naming the model when unknown
+    coords = tuple(names if coordinates is None else coordinates)
+    unknown = [c for c in coords if c not in names]
+    if unknown:
+        raise InputError(f"coordinates not in model {model.name}: {', '.join(unknown)}", element="coordinates",
+                         expected="model coordinate names")
+    dependents = model.coupled_coordinates
+    independent = [n for n in names if n not in dependents]
+
+    q = motion_poses(model, table)
+    qdot = coordinate_speeds(table.time, q[:, [names.index(c) for c in independent]])
+
+    from nmsm.model.muscle_paths import has_active_wrapping
+
+    sources: dict[str, str] = {}
+    for m in muscles:
+        wraps = has_active_wrapping(model, model.muscle(m))
+        if engine == "opensim":
+            sources[m] = "opensim"
+        elif not wraps:
+            sources[m] = "path"
+        elif surrogate is not None and m in surrogate.muscle_names:
+            sources[m] = "surrogate"
+        elif engine == "auto":
+            sources[m] = "opensim"
+        else:
+            raise ModelError(f"muscle '{m}' wraps and the surrogate model does not cover it", file=model.file,
+                             element=f"muscle '{m}'", expected="a surrogate model including it, or engine 'opensim'/'auto'")
+
+    n = table.n_rows
+    lengths = np.zeros((n, len(muscles)))
+    gradient = np.zeros((n, len(muscles), len(independent)))
+    nmsm_cols = [i for i, m in enumerate(muscles) if sources[m] in ("path", "surrogate")]
+    if nmsm_cols:
+        chosen = [muscles[i] for i in nmsm_cols]
+        lengths[:, nmsm_cols], gradient[:, nmsm_cols, :] = _nmsm_geometry(model, q, chosen, independent, surrogate)
+    osim_cols = [i for i, m in enumerate(muscles) if sources[m] == "opensim"]
+    if osim_cols:
+        chosen = [muscles[i] for i in osim_cols]
+        lengths[:, osim_cols], gradient[:, osim_cols, :] = _opensim_geometry(model_file, model, q, chosen, independent,
+                                                                            bridge)
+
+    velocities = np.einsum("nmc,nc->nm", gradient, qdot)
+    arms = np.zeros((n, len(muscles), len(coords)))
+    for k, c in enumerate(coords):
+        driver = c
+        if c in dependents:
+            driver = dependents[c].independent[0]
+        arms[:, :, k] = -gradient[:, :, independent.index(driver)]
+    return MuscleAnalysisResult(table.time.copy(), muscles, coords, lengths, velocities, arms, sources)

@@ -1,0 +1,100 @@
+"""Loading ``.osim`` files: :func:`load_model` reads a model with lxml, no OpenSim in process.
+
+Old file versions (< 40000: 20303, 30000, with joints inside bodies) are not parsed by
+hand: they are upgraded once by OpenSim through the bridge (``resave_model``) into a cache
+keyed by the file's content hash, ``$NMSM_CACHE_DIR`` or ``~/.cache/nmsm/models/``, and
+the upgraded copy is read. Errors name the file the user gave.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+from pathlib import Path
+
+from lxml import etree
+
+from nmsm.errors import ModelError
+from nmsm.model.components import Model
+from nmsm.model.parse_model import parse_model_document
+
+#: first file version nmsm reads directly (OpenSim 4.0 format)
+CURRENT_FORMAT = 40000
+
+
+def cache_dir() -> Path:
+    """Folder of upgraded model copies (``$NMSM_CACHE_DIR/models`` or ``~/.cache/nmsm/models``)."""
+    env = os.environ.get("NMSM_CACHE_DIR")
+    base = Path(env) if env else Path.home() / ".cache" / "nmsm"
+    return base / "models"
+
+
+def read_xml(path: str | Path) -> etree._ElementTree:
+    """The XML tree of ``path`` (comments and layout kept); ModelError if it is not XML."""
+    parser = etree.XMLParser(remove_blank_text=False, huge_tree=True)
+    try:
+        return etree.parse(str(path), parser)
+    except OSError as exc:
+        raise ModelError(f"cannot read the model file ({exc})", file=path) from None
+    except etree.XMLSyntaxError as exc:
+        raise ModelError(f"not a valid XML file ({exc})", file=path, expected="an OpenSim .osim file") from None
+
+
+def file_version(tree: etree._ElementTree, path: str | Path) -> int:
+    root = tree.getroot()
+    if root.tag != "OpenSimDocument":
+        if root.tag == "Model":
+            return 0
+        raise ModelError(f"root element is <{root.tag}>", file=path, expected="<OpenSimDocument> holding a <Model>")
+    try:
+        return int(root.get("Version", "0"))
+    except ValueError:
+        raise ModelError(f"unreadable Version '{root.get('Version')}'", file=path, element="OpenSimDocument",
+                         expected="an integer file version") from None
+
+
+def upgraded_copy(path: str | Path) -> Path:
+    """Path of the OpenSim-upgraded copy of an old ``.osim`` file (made once, cached by hash)."""
+    path = Path(path)
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:20]
+    target = cache_dir() / f"{path.stem}-{digest}.osim"
+    if target.is_file():
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    from nmsm.errors import BridgeError
+    from nmsm.opensim_bridge import get_bridge, opensim_available
+
+    if not opensim_available():
+        raise ModelError(
+            "this model file uses an old format; nmsm upgrades such files once with OpenSim, which is not installed",
+            file=path, expected="an OpenSim 4 model file, or `pip install opensim` to upgrade it automatically")
+    fd, tmp = tempfile.mkstemp(suffix=".osim", dir=target.parent)
+    os.close(fd)
+    try:
+        get_bridge().call("resave_model", path=str(path.resolve()), output=tmp)
+        os.replace(tmp, target)
+    except BridgeError as exc:
+        raise ModelError(f"OpenSim could not upgrade this old-format model: {exc}", file=path) from None
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return target
+
+
+def load_model(path: str | Path) -> Model:
+    """Read the OpenSim model at ``path`` (any OpenSim 3/4 file version)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ModelError("model file not found", file=path, expected="an existing .osim file")
+    tree = read_xml(path)
+    version = file_version(tree, path)
+    if version and version < CURRENT_FORMAT:
+        source = upgraded_copy(path)
+        tree = read_xml(source)
+        model = parse_model_document(tree.getroot(), f"{path} (upgraded copy {source})", version=version,
+                                     source_file=source)
+    else:
+        model = parse_model_document(tree.getroot(), path, version=version, source_file=path)
+    model.file = str(path)
+    return model

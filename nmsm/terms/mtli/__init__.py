@@ -1,0 +1,1 @@
+"""Muscle-Tendon Length Initialization cost terms (``tools = {"MTLI"}``), catalog §3."""

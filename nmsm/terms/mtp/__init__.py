@@ -1,0 +1,1 @@
+"""Muscle-Tendon Personalization cost terms (``tools = {"MTP"}``), catalog §2."""

@@ -1,0 +1,5 @@
+"""Neural Control Personalization (NCP) cost terms (catalog §4), one module per term.
+
+Each term asks :class:`nmsm.tools.ncp.context.NcpContext` for its raw quantity; the
+base class normalizes it and NCP reduces it to ``raw / e / sqrt(numel(raw))``.
+"""

@@ -1,0 +1,1 @@
+"""Synergy Extrapolation cost terms of MTP (``tools = {"SynX"}``), catalog §2."""

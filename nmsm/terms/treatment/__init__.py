@@ -1,0 +1,1 @@
+"""Treatment Optimization cost terms (TO, VO, DO): one module per family."""

@@ -1,0 +1,188 @@
+"""MTP input data: trials read from the personalization folder layout.
+
+Layout (tools.md §0.2)::
+
+    <data_directory>/IDData/<prefix>.sto          inverse-dynamics loads (N m), 101 rows typical
+                     EMGData/<prefix>.sto         processed EMG, rows + 2 * padding
+                     MAData/<prefix>/<prefix>_Length.sto, _Velocity.sto,
+                                     _MomentArm_<coordinate>.sto
+
+Arrays keep time on axis 0: lengths ``(n_frames, n_muscles)`` (m), velocities (m/s),
+moment arms ``(n_frames, n_coordinates, n_muscles)`` (m), moments
+``(n_frames, n_coordinates)`` (N m), EMG ``(n_emg_frames, n_channels)`` (-).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import attrs
+import numpy as np
+
+from nmsm.errors import InputError
+from nmsm.io.storage import Table, read_storage
+from nmsm.io.trials import find_file_by_suffix, find_trial_file, find_trial_folder, trial_prefixes
+
+
+@attrs.frozen(eq=False)
+class TrialData:
+    """One trial's data for MTP (and for NCP without EMG).
+
+    ``time`` (n,) s of the ID/MA rows; ``emg_time`` (n + 2 pad,) s; ``padding`` = EMG frames
+    before and after the ID window.
+    """
+
+    name: str
+    time: np.ndarray
+    muscle_tendon_length: np.ndarray
+    muscle_tendon_velocity: np.ndarray
+    moment_arms: np.ndarray
+    inverse_dynamics_moments: np.ndarray
+    emg_time: np.ndarray | None = None
+    emg: np.ndarray | None = None
+    padding: int = 0
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.time.shape[0])
+
+    @property
+    def emg_time_step(self) -> float:
+        """Mean EMG sample interval (s), as MATLAB's ``mean(diff(emgTime))``."""
+        assert self.emg_time is not None
+        return float(np.mean(np.diff(self.emg_time)))
+
+
+def _columns(table: Table, labels: Sequence[str], what: str) -> np.ndarray:
+    missing = [label for label in labels if not table.has(label)]
+    if missing:
+        raise InputError(
+            f"{what} has no column for {', '.join(missing)}",
+            file=table.source,
+            element=f"column '{missing[0]}'",
+            expected=f"one column per muscle/channel: {', '.join(labels)}",
+        )
+    return table.columns(labels)
+
+
+def read_moment_arms(folder: Path, prefix: str, coordinates: Sequence[str], muscles: Sequence[str]) -> np.ndarray:
+    """Moment arms (n_frames, n_coordinates, n_muscles) from ``<prefix>_MomentArm_<coord>.sto`` files."""
+    arms = []
+    for coordinate in coordinates:
+        try:
+            path = find_file_by_suffix(folder, f"_MomentArm_{coordinate}")
+        except InputError as exc:
+            raise InputError(
+                f"moment-arm file missing for coordinate '{coordinate}' of trial '{prefix}'",
+                file=folder,
+                element=f"{prefix}_MomentArm_{coordinate}.sto",
+                expected="a MuscleAnalysis moment-arm table for every coordinate in <coordinate_list>",
+            ) from exc
+        arms.append(_columns(read_storage(path), muscles, f"moment-arm file for '{coordinate}'"))
+    return np.stack(arms, axis=1)
+
+
+def read_inverse_dynamics(path: Path, coordinates: Sequence[str]) -> Table:
+    """The ID table of a trial (labels ``<coord>_moment``/``_force`` or bare)."""
+    return read_storage(path)
+
+
+def emg_padding(n_emg: int, n_frames: int, source: Path | None = None) -> int:
+    """Padding frames per side: ``(n_emg - n_frames) / 2``; error unless a non-negative integer."""
+    extra = n_emg - n_frames
+    if extra < 0 or extra % 2:
+        raise InputError(
+            f"EMG has {n_emg} rows but ID/MA have {n_frames}: the difference must be even and >= 0",
+            file=source,
+            expected=f"{n_frames} + 2 * padding rows (EMG padded equally on both sides)",
+        )
+    return extra // 2
+
+
+def load_trial(
+    data_directory: str | os.PathLike[str],
+    prefix: str,
+    coordinates: Sequence[str],
+    muscles: Sequence[str],
+    emg_channels: Sequence[str] | None = None,
+    *,
+    ma_directory: str | os.PathLike[str] | None = None,
+) -> TrialData:
+    """Read one trial: ID, MA (lengths, velocities, moment arms) and, if asked, EMG channels."""
+    root = Path(data_directory)
+    id_path = find_trial_file(root / "IDData", prefix)
+    id_table = read_storage(id_path)
+    moments = np.column_stack([id_table.load_column(c) for c in coordinates]) if coordinates else np.zeros((id_table.n_rows, 0))
+    ma_root = Path(ma_directory) if ma_directory is not None else root / "MAData"
+    folder = find_trial_folder(ma_root, prefix)
+    length = read_storage(find_file_by_suffix(folder, "_Length"))
+    velocity = read_storage(find_file_by_suffix(folder, "_Velocity"))
+    lmt = _columns(length, muscles, "muscle-tendon length file")
+    vmt = _columns(velocity, muscles, "muscle-tendon velocity file")
+    arms = read_moment_arms(folder, prefix, coordinates, muscles)
+    n = id_table.n_rows
+    for name, arr, src in (("length", lmt, length.source), ("velocity", vmt, velocity.source)):
+        if arr.shape[0] != n:
+            raise InputError(
+                f"trial '{prefix}': muscle-tendon {name} has {arr.shape[0]} rows but ID has {n}",
+                file=src,
+                expected="MAData and IDData sampled at the same frames",
+            )
+    if arms.shape[0] != n:
+        raise InputError(f"trial '{prefix}': moment arms have {arms.shape[0]} rows but ID has {n}", file=folder)
+    emg_time = emg = None
+    padding = 0
+    if emg_channels is not None:
+        emg_path = find_trial_file(root / "EMGData", prefix)
+        emg_table = read_storage(emg_path)
+        emg = _columns(emg_table, emg_channels, "EMG file")
+        emg_time = emg_table.time
+        padding = emg_padding(emg_table.n_rows, n, emg_path)
+    return TrialData(
+        name=prefix,
+        time=id_table.time,
+        muscle_tendon_length=lmt,
+        muscle_tendon_velocity=vmt,
+        moment_arms=arms,
+        inverse_dynamics_moments=moments,
+        emg_time=emg_time,
+        emg=emg,
+        padding=padding,
+    )
+
+
+def find_prefixes(data_directory: str | os.PathLike[str], requested: Sequence[str] = ()) -> list[str]:
+    """Trial prefixes: the requested ones, else the IDData file names (else IKData)."""
+    if requested:
+        return list(requested)
+    root = Path(data_directory)
+    for sub in ("IDData", "IKData"):
+        if (root / sub).is_dir():
+            found = trial_prefixes(root / sub)
+            if found:
+                return found
+    raise InputError(
+        "no trials found", file=root, expected="IDData/<trial>.sto files or a <trial_prefixes> list"
+    )
+
+
+def check_same_frame_counts(trials: Sequence[TrialData]) -> None:
+    """MTP stacks trials: all need the same number of ID/MA frames and EMG frames."""
+    if not trials:
+        return
+    n = {t.name: t.n_frames for t in trials}
+    if len(set(n.values())) > 1:
+        raise InputError(
+            "trials have different frame counts: " + ", ".join(f"{k}: {v}" for k, v in n.items()),
+            element="IDData/MAData",
+            expected="the same number of rows in every trial (Preprocessing resamples to 101)",
+        )
+    ne = {t.name: (None if t.emg is None else t.emg.shape[0]) for t in trials}
+    if len(set(ne.values())) > 1:
+        raise InputError(
+            "trials have different EMG frame counts: " + ", ".join(f"{k}: {v}" for k, v in ne.items()),
+            element="EMGData",
+            expected="the same number of EMG rows (and padding) in every trial",
+        )

@@ -1,0 +1,219 @@
+"""MTP's modeled quantities as CasADi expressions, one trial at a time.
+
+Chain per trial and muscle (tools.md §4.2, Meyer 2017):
+
+1. excitation ``e_k = S(t_k - EMD/10)``, ``S`` the not-a-knot spline of the (scaled)
+   EMG samples (:mod:`nmsm.tools.mtp.emg_spline`), ``t_k`` evenly spaced over the EMG time;
+2. neural activation by BDF2 with ``tau_a = act/100`` s, padding frames dropped,
+   negatives set to 0;
+3. activation nonlinearity ``A``;
+4. normalized fiber length/velocity with scaled ``l_o``, ``l_ts``; tendon force and passive
+   force (:mod:`nmsm.model.hill`).
+
+One SX function per trial evaluates the chain for one muscle and is ``map``-ped over the
+muscles; the joint moments are MX sums. Design quantities enter in their MTP units:
+electromechanical delay in 0.1 s, activation time constant in 0.01 s.
+
+Shapes of :class:`TrialModel` outputs: excitations ``(n_emg, n_muscles)``, the rest
+``(n_frames, n_muscles)``, moments ``(n_frames, n_coordinates)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import attrs
+import casadi as cs
+import numpy as np
+
+from nmsm.model import hill
+from nmsm.tools.mtp import emg_spline
+from nmsm.tools.mtp.data import TrialData
+from nmsm.tools.mtp.muscles import MuscleParameters
+
+#: upper bound of the electromechanical-delay variable (0.1 s): the spline pieces searched
+MAX_DELAY_VARIABLE = 1.25
+
+
+@attrs.frozen
+class MuscleDesign:
+    """Per-muscle design quantities (CasADi row vectors ``1 x n_muscles`` or numpy (n,)).
+
+    ``electromechanical_delay`` in 0.1 s, ``activation_time_constant`` in 0.01 s,
+    ``activation_nonlinearity`` (-), ``emg_scale`` (-), ``optimal_fiber_length_scale`` and
+    ``tendon_slack_length_scale`` (-).
+    """
+
+    electromechanical_delay: Any
+    activation_time_constant: Any
+    activation_nonlinearity: Any
+    emg_scale: Any
+    optimal_fiber_length_scale: Any
+    tendon_slack_length_scale: Any
+
+    @staticmethod
+    def initial(n_muscles: int) -> MuscleDesign:
+        """The original's initial values (tools.md §4.3)."""
+        return MuscleDesign(
+            electromechanical_delay=np.full(n_muscles, 0.5),
+            activation_time_constant=np.full(n_muscles, 1.5),
+            activation_nonlinearity=np.full(n_muscles, 0.05),
+            emg_scale=np.full(n_muscles, 0.5),
+            optimal_fiber_length_scale=np.ones(n_muscles),
+            tendon_slack_length_scale=np.ones(n_muscles),
+        )
+
+
+def _row(value: Any, n: int) -> cs.MX:
+    """A ``1 x n`` MX row from numpy (n,) or a CasADi vector/row."""
+    if isinstance(value, (cs.MX, cs.SX, cs.DM)):
+        v = cs.MX(value) if not isinstance(value, cs.MX) else value
+        return cs.reshape(v, 1, n)
+    return cs.MX(cs.DM(np.asarray(value, dtype=float).reshape(1, n)))
+
+
+@attrs.frozen(eq=False)
+class TrialModel:
+    """Modeled quantities of one trial (CasADi MX)."""
+
+    name: str
+    excitations: cs.MX
+    excitations_undelayed: cs.MX
+    neural_activations: cs.MX
+    activations: cs.MX
+    normalized_fiber_length: cs.MX
+    normalized_fiber_velocity: cs.MX
+    tendon_force: cs.MX
+    passive_force: cs.MX
+    moments: cs.MX
+
+
+class TrialChain:
+    """Builds the per-muscle SX chain of one trial (sample times, spline pieces, padding).
+
+    ``stride``: the EMG spline goes through every ``stride``-th sample (MATLAB's
+    Synergy Extrapolation path uses 4; its plain path 1 with current sources).
+    """
+
+    def __init__(self, trial: TrialData, *, stride: int = 1, max_delay_variable: float = MAX_DELAY_VARIABLE) -> None:
+        if trial.emg_time is None:
+            raise ValueError(f"trial '{trial.name}' has no EMG")
+        self.trial = trial
+        self.stride = stride
+        t = np.asarray(trial.emg_time, dtype=float)
+        self.n_emg = t.size
+        self.sample_times = (t[-1] - t[0]) * np.linspace(0.0, 1.0, t.size) + t[0]
+        self.breaks = emg_spline.spline_breaks(t, stride)
+        self.spline_matrix = emg_spline.spline_matrix(t, stride)  # (4 P, n_emg)
+        self.dt = float(np.mean(np.diff(t)))
+        self.padding = trial.padding
+        self.max_delay = max_delay_variable / 10.0
+        self.function = self._build()
+
+    @property
+    def n_coefficients(self) -> int:
+        return self.spline_matrix.shape[0]
+
+    def _build(self) -> cs.Function:
+        n = self.trial.n_frames
+        sampler = emg_spline.delayed_sampler(self.breaks, self.sample_times, self.max_delay, "emg_delay")
+        activation = hill.neural_activation_function(self.n_emg)
+        delay = cs.SX.sym("delay")  # 0.1 s
+        tau = cs.SX.sym("tau")  # 0.01 s
+        nonlin = cs.SX.sym("A")
+        coefs = cs.SX.sym("coefs", self.n_coefficients)
+        lmt = cs.SX.sym("lmt", n)
+        vmt = cs.SX.sym("vmt", n)
+        lo = cs.SX.sym("lo")
+        lts = cs.SX.sym("lts")
+        alpha = cs.SX.sym("alpha")
+        f0 = cs.SX.sym("F0")
+        vmax = cs.SX.sym("vmax")
+        e = sampler(delay / 10.0, coefs)
+        neural_all = activation(e, tau / 100.0, self.dt)
+        pad = self.padding
+        neural = cs.fmax(neural_all[pad : pad + n], 0)
+        act = hill.activation_nonlinearity(neural, nonlin)
+        lnorm = hill.normalized_fiber_length(lmt, lo, lts, alpha)
+        vnorm = hill.normalized_fiber_velocity(vmt, lo, alpha, vmax)
+        force = hill.tendon_force(act, lnorm, vnorm, f0, alpha)
+        passive = hill.passive_tendon_force(lnorm, f0, alpha)
+        return cs.Function(
+            f"mtp_muscle_{self.trial.name}",
+            [delay, tau, nonlin, coefs, lmt, vmt, lo, lts, alpha, f0, vmax],
+            [e, neural, act, lnorm, vnorm, force, passive],
+            ["delay", "tau", "A", "coefs", "lmt", "vmt", "lo", "lts", "alpha", "F0", "vmax"],
+            ["e", "n", "a", "l", "v", "F", "Fp"],
+        )
+
+    def emg_coefficients(self, emg: np.ndarray) -> np.ndarray:
+        """Spline coefficients (4 P, k) of EMG samples (n_emg, k)."""
+        return self.spline_matrix @ np.asarray(emg, dtype=float)
+
+    def evaluate(
+        self,
+        muscles: MuscleParameters,
+        design: MuscleDesign,
+        excitation_samples: cs.MX,
+        vmax_factor: float,
+        *,
+        parallel: str = "serial",
+    ) -> TrialModel:
+        """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)`` (MX)."""
+        m = muscles.n_muscles
+        n = self.trial.n_frames
+        coefs = cs.mtimes(cs.DM(self.spline_matrix), excitation_samples)
+        lo = cs.DM(muscles.optimal_fiber_length.reshape(1, m)) * _row(design.optimal_fiber_length_scale, m)
+        lts = cs.DM(muscles.tendon_slack_length.reshape(1, m)) * _row(design.tendon_slack_length_scale, m)
+        mapped = self.function.map(m, parallel) if parallel != "serial" else self.function.map(m)
+        out = mapped(
+            _row(design.electromechanical_delay, m),
+            _row(design.activation_time_constant, m),
+            _row(design.activation_nonlinearity, m),
+            coefs,
+            cs.DM(self.trial.muscle_tendon_length),
+            cs.DM(self.trial.muscle_tendon_velocity),
+            lo,
+            lts,
+            cs.DM(muscles.pennation_angle.reshape(1, m)),
+            cs.DM(muscles.max_isometric_force.reshape(1, m)),
+            cs.DM(np.full((1, m), float(vmax_factor))),
+        )
+        e, neural, act, lnorm, vnorm, force, passive = out
+        moments = joint_moments(self.trial.moment_arms, force)
+        assert moments.shape == (n, self.trial.moment_arms.shape[1])
+        return TrialModel(self.trial.name, e, excitation_samples, neural, act, lnorm, vnorm, force, passive, moments)
+
+
+def joint_moments(moment_arms: np.ndarray, forces: cs.MX) -> cs.MX:
+    """``M[k, c] = sum_m r[k, c, m] F[k, m]`` (N m) for MX forces ``(n_frames, n_muscles)``."""
+    cols = [cs.sum2(cs.DM(moment_arms[:, c, :]) * forces) for c in range(moment_arms.shape[1])]
+    return cs.horzcat(*cols) if cols else cs.MX(forces.shape[0], 0)
+
+
+def scaled_emg_samples(emg: np.ndarray, channel_of_muscle: np.ndarray, emg_scale: Any) -> cs.MX:
+    """``s_emg * EMG`` expanded to muscles ``(n_emg, n_muscles)``; muscles without EMG get 0."""
+    n_emg = emg.shape[0]
+    m = channel_of_muscle.size
+    expanded = expand_emg(emg, channel_of_muscle)
+    return cs.DM(expanded) * cs.repmat(_row(emg_scale, m), n_emg, 1)
+
+
+def expand_emg(emg: np.ndarray, channel_of_muscle: np.ndarray) -> np.ndarray:
+    """EMG channels ``(n_emg, n_channels)`` to muscles ``(n_emg, n_muscles)`` (0 without a channel)."""
+    out = np.zeros((emg.shape[0], channel_of_muscle.size))
+    has = channel_of_muscle >= 0
+    out[:, has] = emg[:, channel_of_muscle[has]]
+    return out
+
+
+def trial_models(
+    chains: Sequence[TrialChain],
+    muscles: MuscleParameters,
+    design: MuscleDesign,
+    excitation_samples: Sequence[cs.MX],
+    vmax_factor: float,
+) -> list[TrialModel]:
+    """Modeled quantities of every trial."""
+    return [c.evaluate(muscles, design, x, vmax_factor) for c, x in zip(chains, excitation_samples)]

@@ -1,0 +1,213 @@
+"""One MTP task as an :class:`~nmsm.core.problem.OptimizationProblem` (IPOPT).
+
+Design-variable blocks (tools.md §4.3), one value per muscle, included by the task's
+``optimize_*`` flags (excluded blocks stay at their current values):
+
+====================================  =========  ======  ==============
+block                                 unit       init    bounds
+====================================  =========  ======  ==============
+``electromechanical_delay``           0.1 s      0.5     [0, 1.25]
+``activation_time_constant``          0.01 s     1.5     [0.75, 3.5]
+``activation_nonlinearity``           -          0.05    [0, 0.35]
+``emg_scale``                         -          0.5     [0.05, 1]
+``optimal_fiber_length_scale``        -          1       [0.6, 1.4]
+``tendon_slack_length_scale``         -          1       [0.6, 1.4]
+``synergy_weights`` (SynX)            -          0       [-100, 100]
+====================================  =========  ======  ==============
+
+Nonlinear inequalities per muscle (soft maximum over trials and frames, k = 500):
+``log(sum(exp(k (l - 1.3)))) / k <= 0`` and ``log(sum(exp(k (0.3 - l)))) / k <= 0``; with
+SynX the extrapolated (unscaled) excitations are bounded to [0, 1] (linear).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import attrs
+import casadi as cs
+import numpy as np
+
+from nmsm.core.problem import OptimizationProblem
+from nmsm.core.term import CostTerm
+from nmsm.tools.mtp.context import MtpContext
+from nmsm.tools.mtp.data import TrialData
+from nmsm.tools.mtp.model import MuscleDesign, TrialChain, TrialModel, expand_emg, scaled_emg_samples
+from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters
+from nmsm.tools.mtp.synx import SynergyExtrapolation
+
+#: block name -> (initial, lower, upper)
+BLOCKS: dict[str, tuple[float, float, float]] = {
+    "electromechanical_delay": (0.5, 0.0, 1.25),
+    "activation_time_constant": (1.5, 0.75, 3.5),
+    "activation_nonlinearity": (0.05, 0.0, 0.35),
+    "emg_scale": (0.5, 0.05, 1.0),
+    "optimal_fiber_length_scale": (1.0, 0.6, 1.4),
+    "tendon_slack_length_scale": (1.0, 0.6, 1.4),
+}
+SYNERGY_WEIGHT_BOUNDS = (-100.0, 100.0)
+#: soft-maximum sharpness and limits of the normalized-fiber-length constraints
+CONSTRAINT_SHARPNESS = 500.0
+CONSTRAINT_MAX_LENGTH = 1.3
+CONSTRAINT_MIN_LENGTH = 0.3
+
+
+@attrs.frozen(eq=False)
+class MtpData:
+    """Fixed inputs of MTP: muscles (base lengths), trials, channel map, groups, SynX."""
+
+    muscles: MuscleParameters
+    coordinates: tuple[str, ...]
+    trials: tuple[TrialData, ...]
+    channel_of_muscle: np.ndarray
+    activation_groups: tuple[MuscleGroup, ...] = ()
+    fiber_length_groups: tuple[MuscleGroup, ...] = ()
+    synx: SynergyExtrapolation | None = None
+    vmax_factor: float = 10.0
+    stride: int = 1
+
+    @property
+    def missing(self) -> tuple[int, ...]:
+        return tuple(int(i) for i in np.flatnonzero(self.channel_of_muscle < 0))
+
+    @property
+    def measured(self) -> tuple[int, ...]:
+        return tuple(int(i) for i in np.flatnonzero(self.channel_of_muscle >= 0))
+
+    @property
+    def padding(self) -> int:
+        return self.trials[0].padding
+
+    def chains(self) -> list[TrialChain]:
+        return [TrialChain(t, stride=self.stride) for t in self.trials]
+
+    def expanded_emg(self) -> list[np.ndarray]:
+        assert all(t.emg is not None for t in self.trials)
+        return [expand_emg(t.emg, self.channel_of_muscle) for t in self.trials]
+
+
+@attrs.define
+class MtpState:
+    """Current values (numpy) of every block: per-muscle arrays (n,) and SynX weights."""
+
+    design: MuscleDesign
+    synergy_weights: np.ndarray = attrs.field(factory=lambda: np.zeros(0))
+
+    @staticmethod
+    def initial(data: MtpData) -> MtpState:
+        n_weights = data.synx.n_weights if data.synx is not None else 0
+        return MtpState(MuscleDesign.initial(data.muscles.n_muscles), np.zeros(n_weights))
+
+
+@attrs.frozen
+class TaskSettings:
+    """What one task optimizes and how it is scored."""
+
+    optimize: dict[str, bool] = attrs.field(factory=lambda: dict.fromkeys(BLOCKS, True))
+    cost_terms: tuple[CostTerm, ...] = ()
+    synx_terms: tuple[CostTerm, ...] = ()
+    min_normalized_fiber_length: float = 0.75
+    max_normalized_fiber_length: float = 1.05
+
+
+def modeled_trials(
+    data: MtpData, design: MuscleDesign, synergy_weights: Any, chains: Sequence[TrialChain] | None = None
+) -> tuple[list[TrialModel], list[TrialModel] | None]:
+    """Modeled quantities of every trial without and (if enabled) with SynX."""
+    chains = list(chains) if chains is not None else data.chains()
+    m = data.muscles.n_muscles
+    plain = []
+    for chain, trial in zip(chains, data.trials):
+        x = scaled_emg_samples(trial.emg, data.channel_of_muscle, design.emg_scale)
+        plain.append(chain.evaluate(data.muscles, design, x, data.vmax_factor))
+    synx_models = None
+    if data.synx is not None:
+        samples = data.synx.excitation_samples(data.expanded_emg(), design.emg_scale, synergy_weights)
+        synx_models = [c.evaluate(data.muscles, design, x, data.vmax_factor) for c, x in zip(chains, samples)]
+    assert all(p.activations.shape[1] == m for p in plain)
+    return plain, synx_models
+
+
+def fiber_length_constraints(models: Sequence[TrialModel]) -> tuple[cs.MX, cs.MX]:
+    """Per-muscle soft maxima of ``l - 1.3`` and ``0.3 - l`` (each ``(n_muscles, 1)``, must be <= 0)."""
+    k = CONSTRAINT_SHARPNESS
+    stacked = cs.vertcat(*[m.normalized_fiber_length for m in models])
+    upper = [cs.logsumexp(k * (stacked[:, i] - CONSTRAINT_MAX_LENGTH)) / k for i in range(stacked.shape[1])]
+    lower = [cs.logsumexp(k * (CONSTRAINT_MIN_LENGTH - stacked[:, i])) / k for i in range(stacked.shape[1])]
+    return cs.vertcat(*upper), cs.vertcat(*lower)
+
+
+def build_task_problem(
+    data: MtpData,
+    state: MtpState,
+    task: TaskSettings,
+    initial_fiber_length: Sequence[np.ndarray],
+    *,
+    chains: Sequence[TrialChain] | None = None,
+    name: str = "MTP task",
+) -> tuple[OptimizationProblem, MtpContext]:
+    """The task's problem (variables, terms, constraints) and the terms' context."""
+    problem = OptimizationProblem(name)
+    m = data.muscles.n_muscles
+    values: dict[str, Any] = {}
+    for block, (_, lower, upper) in BLOCKS.items():
+        current = np.asarray(getattr(state.design, block), dtype=float)
+        if task.optimize.get(block, True):
+            values[block] = cs.reshape(problem.variable(block, np.clip(current, lower, upper), lower, upper), 1, m)
+        else:
+            values[block] = cs.MX(cs.DM(current.reshape(1, m)))
+    design = MuscleDesign(**values)
+    weights: Any = cs.MX(0, 1)
+    if data.synx is not None:
+        low, high = SYNERGY_WEIGHT_BOUNDS
+        weights = problem.variable("synergy_weights", np.clip(state.synergy_weights, low, high), low, high)
+    plain, synx_models = modeled_trials(data, design, weights, chains)
+    ctx = MtpContext(
+        muscles=data.muscles,
+        design=design,
+        models=plain,
+        synx_models=synx_models,
+        inverse_dynamics_moments=[t.inverse_dynamics_moments for t in data.trials],
+        initial_fiber_length=list(initial_fiber_length),
+        activation_groups=data.activation_groups,
+        fiber_length_groups=data.fiber_length_groups,
+        measured=data.measured,
+        missing=data.missing,
+        padding=data.padding,
+        min_normalized_fiber_length=task.min_normalized_fiber_length,
+        max_normalized_fiber_length=task.max_normalized_fiber_length,
+    )
+    for term in task.cost_terms:
+        problem.add_term(term, ctx)
+    if data.synx is not None:
+        for term in task.synx_terms:
+            problem.add_term(term, ctx)
+    upper, lower = fiber_length_constraints(plain)
+    problem.add_constraint("normalized_fiber_length_max_1.3", upper, -np.inf, 0.0)
+    problem.add_constraint("normalized_fiber_length_min_0.3", lower, -np.inf, 0.0)
+    if data.synx is not None and data.synx.method == "PCA":
+        problem.add_constraint("extrapolated_excitation_0_1", data.synx.extrapolated_bounds_expression(weights), 0.0, 1.0)
+    return problem, ctx
+
+
+def updated_state(state: MtpState, values: dict[str, np.ndarray]) -> MtpState:
+    """State with the solved blocks replaced."""
+    design = attrs.evolve(
+        state.design,
+        **{k: np.asarray(v, dtype=float).ravel() for k, v in values.items() if k in BLOCKS},
+    )
+    weights = np.asarray(values["synergy_weights"], dtype=float).ravel() if "synergy_weights" in values else state.synergy_weights
+    return MtpState(design, weights)
+
+
+def absorb_length_scales(data: MtpData, state: MtpState) -> tuple[MtpData, MtpState]:
+    """After a task: base lengths take the scale factors, which reset to 1 (as the original)."""
+    d = state.design
+    muscles = data.muscles.with_lengths(
+        data.muscles.optimal_fiber_length * np.asarray(d.optimal_fiber_length_scale, dtype=float),
+        data.muscles.tendon_slack_length * np.asarray(d.tendon_slack_length_scale, dtype=float),
+    )
+    n = muscles.n_muscles
+    design = attrs.evolve(d, optimal_fiber_length_scale=np.ones(n), tendon_slack_length_scale=np.ones(n))
+    return attrs.evolve(data, muscles=muscles), MtpState(design, state.synergy_weights)

@@ -1,0 +1,228 @@
+"""From NCP settings to :class:`NcpInputs`: model, synergy groups, trials, MTP results.
+
+Reads (tools.md §5, settings-xml.md §3):
+
+* the model (muscles crossing ``coordinate_list``; ForceSet groups for synergy groups,
+  activation groups and normalized-fiber-length groups);
+* per trial ``IDData/<trial>.sto`` and ``MAData/<trial>/`` (lengths, velocities, moment
+  arms), through MTP's reader;
+* with ``mtp_results_directory``: ``muscleActivations/<trial>*.sto``, and muscle
+  parameters from ``input_osimx_file`` (absolute l_o, l_ts, F0 of its RCNLMuscle entries).
+
+Tracked coordinates are those of ``coordinate_list`` with an ID column (the others still
+select muscles; a warning names them).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+
+import attrs
+import numpy as np
+
+from nmsm.core.term import Term, build_terms
+from nmsm.errors import InputError
+from nmsm.io.osimx import OsimxModel, read_osimx
+from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
+from nmsm.io.storage import read_storage
+from nmsm.io.trials import find_trial_file
+from nmsm.model import load_model
+from nmsm.model.components import Model
+from nmsm.tools.mtp.data import find_prefixes, load_trial
+from nmsm.tools.mtp.muscles import MuscleParameters, resolve_groups
+from nmsm.tools.ncp.inputs import NcpInputs, NcpTrial
+from nmsm.tools.ncp.muscle_set import muscles_crossing, synergy_groups
+from nmsm.tools.ncp.spline import DEFAULT_NODE_COUNT
+from nmsm.tools.ncp.symmetry import mirror_muscle_map
+from nmsm.tools.ncp.synergies import SynergyLayout
+
+
+@attrs.frozen(eq=False)
+class NcpSetup:
+    """Everything a run needs: the arrays, the terms, and where they came from.
+
+    ``mtp_activation_files`` per trial (None without MTP results); ``osimx`` the input
+    ``.osimx`` (None if not given).
+    """
+
+    settings: NeuralControlPersonalizationSettings
+    model: Model
+    inputs: NcpInputs
+    terms: tuple[Term, ...]
+    osimx: OsimxModel | None
+    mtp_activation_files: tuple[Path, ...] | None
+    dropped_coordinates: tuple[str, ...] = ()
+
+
+def tracked_coordinates(settings: NeuralControlPersonalizationSettings, prefix: str) -> tuple[list[str], list[str]]:
+    """``coordinate_list`` entries with an ID column in trial ``prefix`` (and those without)."""
+    table = read_storage(find_trial_file(Path(settings.data_directory) / "IDData", prefix))
+    labels = set(table.labels)
+    kept, dropped = [], []
+    for c in settings.coordinate_list:
+        (kept if {c, c + "_moment", c + "_force"} & labels else dropped).append(c)
+    if not kept:
+        raise InputError(
+            "no coordinate of <coordinate_list> has a column in the inverse-dynamics file",
+            file=table.source,
+            element="<coordinate_list>",
+            expected="ID columns named <coordinate>, <coordinate>_moment or <coordinate>_force",
+        )
+    return kept, dropped
+
+
+def _muscle_parameters(model: Model, muscles: Sequence[str], osimx: OsimxModel | None) -> MuscleParameters:
+    """Model parameters of ``muscles``, replaced by the osimx's absolute values where given."""
+    f0, lo, lts, alpha = [], [], [], []
+    for name in muscles:
+        m = model.muscle(name)
+        personal = osimx.muscles.get(name) if osimx is not None else None
+        f0.append(personal.max_isometric_force if personal and personal.max_isometric_force is not None else m.max_isometric_force)
+        lo.append(personal.optimal_fiber_length if personal and personal.optimal_fiber_length is not None else m.optimal_fiber_length)
+        lts.append(personal.tendon_slack_length if personal and personal.tendon_slack_length is not None else m.tendon_slack_length)
+        alpha.append(m.pennation_angle_at_optimal)
+    return MuscleParameters(muscles, f0, lo, lts, alpha)
+
+
+def _mtp_activations(
+    directory: Path, prefixes: Sequence[str], muscles: Sequence[str], frames: Sequence[int]
+) -> tuple[tuple[str, ...], list[np.ndarray], list[Path]]:
+    """MTP activations of the NCP muscles present in every trial's file.
+
+    A muscle present in one trial's file and absent from another's is an error naming the
+    file and column; so is a file whose row count differs from the trial's ID rows.
+    """
+    folder = directory / "muscleActivations"
+    tables, files = [], []
+    for prefix in prefixes:
+        path = find_trial_file(folder, prefix)
+        tables.append(read_storage(path))
+        files.append(path)
+    present = [set(t.labels) for t in tables]
+    union = [m for m in muscles if any(m in p for p in present)]
+    for table, labels in zip(tables, present):
+        missing = [m for m in union if m not in labels]
+        if missing:
+            raise InputError(
+                f"MTP activations lack muscle(s) {', '.join(missing)} that other trials' MTP activations have",
+                file=table.source,
+                element=f"column '{missing[0]}'",
+                expected="the same muscles in every trial's muscleActivations file",
+            )
+    for table, n, prefix in zip(tables, frames, prefixes):
+        if table.n_rows != n:
+            raise InputError(
+                f"MTP activations of trial '{prefix}' have {table.n_rows} rows but its ID/MA data have {n}",
+                file=table.source,
+                expected=f"{n} rows (MTP output of the same trial)",
+            )
+    return tuple(union), [t.columns(union) for t in tables], files
+
+
+def load_ncp(
+    settings: NeuralControlPersonalizationSettings,
+    *,
+    enforce_bilateral_symmetry: bool | None = None,
+    n_nodes: int = DEFAULT_NODE_COUNT,
+) -> NcpSetup:
+    """Read everything NCP needs (see module docstring); ``enforce_bilateral_symmetry`` overrides the setting."""
+    settings_file = settings.settings_file
+    model = load_model(settings.input_model_file)
+    crossing = muscles_crossing(model, settings.coordinate_list)
+    requested = [(g.muscle_group_name, g.num_synergies) for g in settings.synergy_groups]
+    groups = synergy_groups(model, requested, crossing, settings_file=settings_file)
+    symmetric = settings.enforce_bilateral_symmetry if enforce_bilateral_symmetry is None else enforce_bilateral_symmetry
+    shared = None
+    if symmetric:
+        if len(groups) != 2:
+            raise InputError(
+                f"bilateral symmetry needs exactly two synergy groups, found {len(groups)}",
+                file=settings_file,
+                element="<enforce_bilateral_symmetry>",
+                expected="two <RCNLSynergy> elements (left and right)",
+            )
+        if groups[0].n_synergies != groups[1].n_synergies or groups[0].n_muscles != groups[1].n_muscles:
+            raise InputError(
+                f"bilateral symmetry needs groups of equal size: '{groups[0].name}' has {groups[0].n_muscles} muscles "
+                f"and {groups[0].n_synergies} synergies, '{groups[1].name}' {groups[1].n_muscles} and {groups[1].n_synergies}",
+                file=settings_file,
+                element="<enforce_bilateral_symmetry>",
+                expected="mirror-image synergy groups",
+            )
+        shared = (None, (0, mirror_muscle_map(groups[0].muscles, groups[1].muscles)))
+    layout = SynergyLayout(groups, n_nodes=n_nodes, shared_from=shared)
+    muscles = layout.muscles
+    prefixes = find_prefixes(settings.data_directory, settings.trial_prefixes)
+    coordinates, dropped = tracked_coordinates(settings, prefixes[0])
+    if dropped:
+        warnings.warn(
+            f"{settings_file}: coordinate(s) {', '.join(dropped)} of <coordinate_list> have no inverse-dynamics "
+            "column; they select muscles but their moments are not tracked",
+            stacklevel=2,
+        )
+    raw = [load_trial(settings.data_directory, p, coordinates, muscles) for p in prefixes]
+    osimx = read_osimx(settings.input_osimx_file) if settings.input_osimx_file else None
+    mtp_muscles: tuple[str, ...] = ()
+    mtp_data: list[np.ndarray | None] = [None] * len(raw)
+    files = None
+    if settings.mtp_results_directory is not None:
+        mtp_muscles, arrays, paths = _mtp_activations(
+            Path(settings.mtp_results_directory), prefixes, muscles, [t.n_frames for t in raw]
+        )
+        mtp_data = list(arrays)
+        files = tuple(paths)
+        if osimx is None:
+            warnings.warn(
+                f"{settings_file}: MTP activations are tracked but <input_osimx_file> is empty: the model's "
+                "muscle parameters are used, not MTP's",
+                stacklevel=2,
+            )
+    id_labels = _load_labels(settings, prefixes[0], coordinates)
+    trials = [
+        NcpTrial(
+            name=t.name,
+            time=t.time,
+            lengths=t.muscle_tendon_length,
+            velocities=t.muscle_tendon_velocity,
+            moment_arms=t.moment_arms,
+            moments=t.inverse_dynamics_moments,
+            mtp_activations=a if mtp_muscles else None,
+            load_labels=id_labels,
+        )
+        for t, a in zip(raw, mtp_data)
+    ]
+    parameters = _muscle_parameters(model, muscles, osimx)
+    activation_groups = resolve_groups(
+        settings.activation_muscle_groups, model.groups, muscles, setting="activation_muscle_groups",
+        model_file=str(settings.input_model_file),
+    )
+    fiber_groups = resolve_groups(
+        settings.normalized_fiber_length_muscle_groups, model.groups, muscles,
+        setting="normalized_fiber_length_muscle_groups", model_file=str(settings.input_model_file),
+    )
+    inputs = NcpInputs(
+        layout=layout,
+        coordinates=coordinates,
+        trials=trials,
+        muscles=parameters,
+        mtp_muscles=mtp_muscles,
+        activation_groups=activation_groups,
+        fiber_length_groups=fiber_groups,
+        v_max_factor=settings.v_max_factor,
+    )
+    terms = tuple(build_terms(list(settings.cost_terms), "NCP"))
+    return NcpSetup(settings, model, inputs, terms, osimx, files, tuple(dropped))
+
+
+def _load_labels(settings: NeuralControlPersonalizationSettings, prefix: str, coordinates: Sequence[str]) -> tuple[str, ...]:
+    """ID column label of each tracked coordinate (``<c>_moment``, ``<c>_force`` or ``<c>``)."""
+    table = read_storage(find_trial_file(Path(settings.data_directory) / "IDData", prefix))
+    out = []
+    for c in coordinates:
+        for label in (c + "_moment", c + "_force", c):
+            if table.has(label):
+                out.append(label)
+                break
+    return tuple(out)

@@ -1,0 +1,118 @@
+"""The NCP optimization problem: synergy variables, terms, weight-sum constraints.
+
+Design variables (all >= 0, no upper bounds; tools.md §5):
+
+* ``weights_<group>`` (S_g, M_g) for each group whose vectors are free (a group sharing
+  another's vectors under bilateral symmetry has none);
+* ``nodes_<trial>`` (N, S): command spline nodes of every synergy in the trial.
+
+Activations ``a_t = (B @ nodes_t) @ W`` are bilinear in the variables and moments linear in
+activations, so the objective is a polynomial whose exact Hessian CasADi forms cheaply.
+Each free group's vectors sum to ``M_g/100`` (:class:`SynergyWeightSum`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import attrs
+import numpy as np
+
+from nmsm.constraints.ncp.synergy_weight_sum import SynergyWeightSum
+from nmsm.core.problem import OptimizationProblem, Solution
+from nmsm.core.term import Term
+from nmsm.tools.ncp.context import NcpContext
+from nmsm.tools.ncp.initial_guess import SynergyGuess
+from nmsm.tools.ncp.inputs import NcpInputs
+from nmsm.tools.ncp.solution import SynergySolution
+from nmsm.tools.ncp.synergies import activations as synergy_activations
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c == "_" else "_" for c in name)
+
+
+def _scale(values: np.ndarray, floor: float) -> float:
+    positive = np.asarray(values)[np.asarray(values) > 0]
+    return float(max(positive.mean() if positive.size else 0.0, floor))
+
+
+@attrs.define
+class NcpProblem:
+    """The built problem, its context and the names of its variables."""
+
+    inputs: NcpInputs
+    problem: OptimizationProblem
+    context: NcpContext
+    weight_variables: list[str]
+    node_variables: list[str]
+
+    def solution(self, solved: Solution) -> SynergySolution:
+        """The synergies (not normalized) at a solved point."""
+        return self.synergies_from_values(solved.values)
+
+    def synergies_from_values(self, values: dict[str, np.ndarray]) -> SynergySolution:
+        layout = self.inputs.layout
+        blocks = [np.asarray(values[name]) for name in self.weight_variables]
+        weights = layout.weight_matrix(blocks)
+        nodes = [np.asarray(values[name]) for name in self.node_variables]
+        commands = [layout.commands(n, t.n_points) for n, t in zip(nodes, self.inputs.trials)]
+        return SynergySolution(
+            layout=layout,
+            weights=weights,
+            commands=commands,
+            nodes=nodes,
+            trial_names=[t.name for t in self.inputs.trials],
+        )
+
+
+def build_problem(inputs: NcpInputs, terms: Sequence[Term], guess: SynergyGuess, *, name: str = "ncp") -> NcpProblem:
+    """Declare the variables, add ``terms`` and the weight-sum constraints (see module docstring)."""
+    layout = inputs.layout
+    problem = OptimizationProblem(name)
+    weight_names: list[str] = []
+    free_blocks: list[Any] = []
+    for block_index, group in enumerate(layout.free_groups):
+        g = layout.groups[group]
+        var = f"weights_{_safe(g.name)}"
+        initial = guess.weight_blocks[block_index]
+        expr = problem.variable(var, initial, lower=0.0, upper=np.inf, scale=g.weight_sum / g.n_muscles)
+        weight_names.append(var)
+        free_blocks.append(expr)
+    weight_blocks = layout.group_blocks(free_blocks)
+    weights = layout.weight_matrix(free_blocks)
+    node_names: list[str] = []
+    activations = []
+    for t, trial in enumerate(inputs.trials):
+        var = f"nodes_{_safe(trial.name)}_{t}"
+        initial = guess.nodes[t]
+        nodes = problem.variable(var, initial, lower=0.0, upper=np.inf, scale=_scale(initial, 1e-2))
+        node_names.append(var)
+        activations.append(synergy_activations(weights, layout.commands(nodes, trial.n_points)))
+    context = NcpContext(inputs, weight_blocks, activations)
+    for term in terms:
+        problem.add_term(term, context)
+    for group in layout.free_groups:
+        g = layout.groups[group]
+        problem.add_term(SynergyWeightSum(group=group, target=g.weight_sum, name=g.name), context)
+    return NcpProblem(inputs, problem, context, weight_names, node_names)
+
+
+def score(inputs: NcpInputs, terms: Sequence[Term], solution: SynergySolution) -> dict[str, float]:
+    """Each cost term's value (and ``total``) for a given solution, evaluated with numpy."""
+    blocks = [solution.group_weights(g) for g in range(len(inputs.layout.groups))]
+    context = NcpContext(inputs, blocks, solution.all_activations())
+    out: dict[str, float] = {}
+    for term in terms:
+        if getattr(term, "kind", "") != "cost":
+            continue
+        residuals = np.asarray(term.residuals(context), dtype=float)
+        key = term.label
+        k = 2
+        while key in out:
+            key = f"{term.label}#{k}"
+            k += 1
+        out[key] = float(np.sum(residuals**2))
+    out["total"] = float(sum(out.values()))
+    return out

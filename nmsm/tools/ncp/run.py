@@ -1,0 +1,171 @@
+"""``nmsm run`` for ``<NeuralControlPersonalizationTool>``: read, optimize, write.
+
+:func:`run_settings` reads the settings (older schemas upgraded), loads the model and
+data (:mod:`nmsm.tools.ncp.loading`), builds the problem (:mod:`nmsm.tools.ncp.problem`)
+from the NMF start (:mod:`nmsm.tools.ncp.initial_guess`), solves it with IPOPT (exact
+derivatives), normalizes the synergies (largest weight one) and writes the results
+(:mod:`nmsm.tools.ncp.outputs`) through a staging folder, together with a copy of the
+settings file and ``commandWindowOutput.txt`` (solver summary, costs, fit metrics).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import Any
+
+import attrs
+
+from nmsm.core.problem import Solution
+from nmsm.core.results import ResultsDirectory
+from nmsm.errors import SolverError
+from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
+from nmsm.tools.ncp.initial_guess import initial_guess
+from nmsm.tools.ncp.loading import NcpSetup, load_ncp
+from nmsm.tools.ncp.metrics import FitMetrics, fit_metrics
+from nmsm.tools.ncp.outputs import (
+    WEIGHTS_FILE,
+    ncp_osimx,
+    osimx_file_name,
+    relative_model_path,
+    write_ncp_osimx,
+    write_synergy_weights,
+    write_trial_files,
+)
+from nmsm.tools.ncp.problem import build_problem, score
+from nmsm.tools.ncp.solution import SynergySolution
+
+#: log written into the results folder, as the original's
+LOG_FILE = "commandWindowOutput.txt"
+
+
+@attrs.frozen(eq=False)
+class NcpRun:
+    """What a run produced: normalized synergies, solver result, costs, fit metrics, files."""
+
+    setup: NcpSetup
+    solution: SynergySolution
+    solver: Solution
+    costs: dict[str, float]
+    metrics: FitMetrics
+    results_directory: Path
+    osimx_file: Path
+    wall_time: float
+
+
+def read_settings(path: str | os.PathLike[str]) -> NeuralControlPersonalizationSettings:
+    """Validated NCP settings of ``path`` (older schemas upgraded with a warning)."""
+    return NeuralControlPersonalizationSettings.from_document(read_settings_document(path))
+
+
+def _ipopt_options(settings: NeuralControlPersonalizationSettings, overrides: dict[str, Any]) -> dict[str, Any]:
+    options: dict[str, Any] = {
+        "max_iter": int(settings.max_iterations),
+        "tol": 1e-6,
+        "acceptable_tol": 1e-4,
+        "print_level": 5,
+        "ipopt_options": {"mu_strategy": "adaptive"},
+    }
+    options.update({k: v for k, v in overrides.items() if v is not None})
+    return options
+
+
+def solve(setup: NcpSetup, **ipopt_options: Any) -> tuple[SynergySolution, Solution]:
+    """Optimize the synergies of ``setup``; returns the (not normalized) solution and the solver result."""
+    guess = initial_guess(setup.inputs)
+    built = build_problem(setup.inputs, setup.terms, guess)
+    solved = built.problem.solve("ipopt", **ipopt_options)
+    if not solved.success and "Maximum_Iterations" not in solved.status and "Acceptable" not in solved.status:
+        raise SolverError(f"NCP optimization failed: IPOPT status {solved.status} after {solved.iterations} iterations")
+    return built.solution(solved), solved
+
+
+def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metrics: FitMetrics, wall: float) -> str:
+    inputs = setup.inputs
+    lines = [
+        f"Neural Control Personalization: {setup.settings.settings_file}",
+        f"model {setup.settings.input_model_file}; {inputs.layout.n_muscles} muscles, "
+        f"{inputs.layout.n_synergies} synergies "
+        + ", ".join(f"{g.name}: {g.n_synergies} of {g.n_muscles} muscles" for g in inputs.layout.groups),
+        f"bilateral symmetry (shared vectors): {'yes' if any(s is not None for s in inputs.layout.shared_from) else 'no'}",
+        f"trials: {', '.join(t.name for t in inputs.trials)}; muscles with MTP activations: {len(inputs.mtp_muscles)}",
+        solved.summary(),
+        "cost terms at the solution:",
+        *[f"  {k:<40s} {v:.8g}" for k, v in costs.items()],
+        "moment RMS (N m) per coordinate:",
+        *[f"  {c:<40s} {v:.4f}" for c, v in zip(metrics.coordinates, metrics.moment_rms)],
+        f"  mean over coordinates                    {metrics.mean_moment_rms:.4f}",
+        f"activation RMS vs MTP (pooled): {metrics.activation_rms_pooled:.5f}; VAF {100 * metrics.activation_vaf:.2f} %",
+        f"wall time {wall:.1f} s",
+    ]
+    if setup.dropped_coordinates:
+        lines.append("coordinates without ID data (not tracked): " + ", ".join(setup.dropped_coordinates))
+    return "\n".join(lines) + "\n"
+
+
+def run_settings(
+    path: str | os.PathLike[str],
+    *,
+    results_directory: str | os.PathLike[str] | None = None,
+    enforce_bilateral_symmetry: bool | None = None,
+    max_iterations: int | None = None,
+    tolerance: float | None = None,
+    print_level: int | None = None,
+    plots: bool = False,
+    **ipopt: Any,
+) -> NcpRun:
+    """Run NCP as the settings file ``path`` says.
+
+    Options override the settings: ``results_directory``, ``enforce_bilateral_symmetry``,
+    ``max_iterations``, ``tolerance`` (IPOPT ``tol``), ``print_level`` (IPOPT output, 0 quiet);
+    other keyword arguments go to the IPOPT back end. ``plots=True`` also saves the NCP
+    figures (:func:`nmsm.plots.ncp.plot_ncp_results`) into ``<results>/plots``.
+    """
+    start = time.perf_counter()
+    settings = read_settings(path)
+    if results_directory is not None:
+        settings = attrs.evolve(settings, results_directory=Path(results_directory))
+    setup = load_ncp(settings, enforce_bilateral_symmetry=enforce_bilateral_symmetry)
+    options = _ipopt_options(settings, {"max_iter": max_iterations, "tol": tolerance, "print_level": print_level, **ipopt})
+    raw, solved = solve(setup, **options)
+    solution = raw.normalized()
+    costs = score(setup.inputs, setup.terms, solution)
+    metrics = fit_metrics(setup.inputs, solution)
+    out_dir = Path(settings.results_directory)
+    inputs_used = [settings.input_model_file, settings.settings_file]
+    if settings.input_osimx_file:
+        inputs_used.append(settings.input_osimx_file)
+    results = ResultsDirectory(out_dir, inputs=[p for p in inputs_used if p])
+    osimx_name = osimx_file_name(settings.input_osimx_file, settings.input_model_file)
+    wall = time.perf_counter() - start
+    with results.task("ncp") as stage:
+        write_synergy_weights(stage / WEIGHTS_FILE, solution)
+        write_trial_files(stage, setup.inputs, solution)
+        osimx = ncp_osimx(
+            setup.osimx,
+            setup.model.name,
+            relative_model_path(Path(settings.input_model_file), out_dir),
+            setup.inputs,
+        )
+        write_ncp_osimx(stage / osimx_name, osimx)
+        settings_copy = out_dir / Path(settings.settings_file).name
+        if settings_copy.resolve() != Path(settings.settings_file).resolve():
+            shutil.copy2(settings.settings_file, stage / settings_copy.name)
+        (stage / LOG_FILE).write_text(_log_text(setup, solved, costs, metrics, wall), encoding="utf-8")
+    if plots:
+        from nmsm.plots.ncp import plot_ncp_results
+
+        plot_ncp_results(out_dir, out_dir / "plots")
+    return NcpRun(
+        setup=setup,
+        solution=solution,
+        solver=solved,
+        costs=costs,
+        metrics=metrics,
+        results_directory=out_dir,
+        osimx_file=out_dir / osimx_name,
+        wall_time=time.perf_counter() - start,
+    )

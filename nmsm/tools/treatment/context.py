@@ -1,0 +1,658 @@
+"""The context through which Treatment Optimization terms read modeled and tracked quantities.
+
+A term receives a :class:`TreatmentContext`. It is a :class:`GridView` of the *collocation
+points* (``K`` rows: continuous costs and path constraints) and gives views of the phase's
+``initial`` and ``final`` points (one row each: terminal constraints), plus problem-wide
+quantities (final time, static parameters, synergy weights). Every quantity is a CasADi
+MX expression computed lazily - only when a term asks for it - and cached per grid; model
+quantities are per-point SX functions ``map``\\ ped over the grid's rows.
+
+Quantities of a :class:`GridView` (``n`` = rows of the grid; SI units, radians):
+
+=========================================  ============  =============================================
+method                                     shape         meaning
+=========================================  ============  =============================================
+``time()``                                 (n, 1)  s     time of each row (``t_f * s``)
+``normalized_time``                        (n,)          ``s`` in [0, 1] (numpy)
+``coordinate(c)`` / ``speed(c)`` /         (n, 1)        q, q̇, q̈ of any model coordinate (state,
+``acceleration(c)``                                      prescribed or coupler-dependent), rad|m
+``positions()`` / ``speeds()`` /           (n, nq)       all coordinates, model order
+``accelerations()``
+``tracked_coordinate(c)`` / ``_speed`` /   (n, 1)        experimental reference (tracked IK spline)
+``_acceleration``
+``inverse_dynamics_load(load)``            (n, 1)  N·m|N inverse dynamics of the modeled motion;
+                                                         ``load`` = ``<coord>_moment|_force`` or coord
+``inverse_dynamics()``                     (n, nq)       all ID loads, model order
+``tracked_load(load)``                     (n, 1)        experimental ID (tracked IDData)
+``controller_load(load)``                  (n, 1)        what the controllers apply on the coordinate
+                                                         (muscle moments + torque controls)
+``marker_position(m)`` / ``_velocity(m)``  (n, 3)  m, m/s model marker in ground
+``tracked_marker_position(m)`` / ``_vel``  (n, 3)        marker on the tracked kinematics
+``body_orientation(b, sequence)``          (n, 3)  rad   body-fixed angles (``sequence`` order)
+``tracked_body_orientation(b, sequence)``  (n, 3)        on the tracked kinematics
+``control(name)``                          (n, 1)        a controller's control (torque N·m|N,
+                                                         synergy activation, muscle activation)
+``initial_control(name)``                  (n, 1)        its initial-guess reference
+``muscle_activation(m)``                   (n, 1)        modeled activation (synergy or muscle
+                                                         controller), 0..1
+``tracked_muscle_activation(m)``           (n, 1)        reference activation (initial-guess dir)
+``normalized_fiber_length(m)``             (n, 1)        l̃ of the Hill model
+=========================================  ============  =============================================
+
+Problem-wide (on :class:`TreatmentContext`): ``final_time`` (MX scalar, s),
+``parameter(type)`` (MX column of a DO static parameter), ``synergy_weights(group)`` (MX
+(S, M)), ``initial_synergy_weights(group)`` (numpy), ``integrate(values)`` (normalized-time
+integral of a (K, m) expression), ``controller_names``, ``muscle_names``, ``model``.
+
+Name checks (call from ``Term.bind``; they raise :class:`InputError` naming the term's
+settings file and line): ``require_coordinate``, ``require_state_coordinate``,
+``require_load``, ``require_tracked_load``, ``require_marker``, ``require_body``,
+``require_control``, ``require_muscle``, ``require_tracked_activation``,
+``require_parameter``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+import casadi as cs
+import numpy as np
+
+from nmsm.core import reductions
+from nmsm.tools.treatment.orientation import check_sequence, euler_angles
+from nmsm.tools.treatment.transcription.base import Trajectory, map_rows
+
+if TYPE_CHECKING:
+    from nmsm.core.term import ConstraintTerm, CostTerm
+    from nmsm.tools.treatment.model_interface import TreatmentModel
+    from nmsm.tools.treatment.problem_data import TreatmentData
+
+
+class GridView:
+    """Quantities on one grid of the transcribed phase (see module docstring)."""
+
+    def __init__(self, quantities: _Quantities, grid: str) -> None:
+        self._q = quantities
+        self.grid = grid
+
+    # ---- time -------------------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        return self._q.trajectory.grid_size(self.grid)
+
+    @property
+    def normalized_time(self) -> np.ndarray:
+        return self._q.trajectory.normalized_times(self.grid)
+
+    def time(self) -> cs.MX:
+        return self._q.trajectory.times(self.grid)
+
+    # ---- kinematics -----------------------------------------------------------------------
+    def positions(self) -> cs.MX:
+        return self._q.kinematics(self.grid)[0]
+
+    def speeds(self) -> cs.MX:
+        return self._q.kinematics(self.grid)[1]
+
+    def accelerations(self) -> cs.MX:
+        return self._q.kinematics(self.grid)[2]
+
+    def coordinate(self, name: str) -> cs.MX:
+        return self.positions()[:, self._q.coordinate_index(name)]
+
+    def speed(self, name: str) -> cs.MX:
+        return self.speeds()[:, self._q.coordinate_index(name)]
+
+    def acceleration(self, name: str) -> cs.MX:
+        return self.accelerations()[:, self._q.coordinate_index(name)]
+
+    def tracked_coordinate(self, name: str) -> cs.MX:
+        return self._q.tracked_kinematics(self.grid, 0)[:, self._q.coordinate_index(name)]
+
+    def tracked_speed(self, name: str) -> cs.MX:
+        return self._q.tracked_kinematics(self.grid, 1)[:, self._q.coordinate_index(name)]
+
+    def tracked_acceleration(self, name: str) -> cs.MX:
+        return self._q.tracked_kinematics(self.grid, 2)[:, self._q.coordinate_index(name)]
+
+    # ---- kinetics ------------------------------------------------------------------------
+    def inverse_dynamics(self) -> cs.MX:
+        return self._q.inverse_dynamics(self.grid)
+
+    def inverse_dynamics_load(self, load: str) -> cs.MX:
+        return self.inverse_dynamics()[:, self._q.load_index(load)]
+
+    def tracked_load(self, load: str) -> cs.MX:
+        return self._q.tracked_loads(self.grid, load)
+
+    def controller_load(self, load: str) -> cs.MX:
+        return self._q.controller_load(self.grid, self._q.load_coordinate(load))
+
+    def load_coordinate(self, load: str) -> str:
+        """The coordinate of an ID load label (``knee_angle_r_moment`` -> ``knee_angle_r``)."""
+        return self._q.load_coordinate(load)
+
+    # ---- points and bodies ------------------------------------------------------------------
+    def marker_position(self, marker: str) -> cs.MX:
+        return self._q.marker(self.grid, marker)[0]
+
+    def marker_velocity(self, marker: str) -> cs.MX:
+        return self._q.marker(self.grid, marker)[1]
+
+    def tracked_marker_position(self, marker: str) -> cs.MX:
+        return self._q.tracked_marker(self.grid, marker)[0]
+
+    def tracked_marker_velocity(self, marker: str) -> cs.MX:
+        return self._q.tracked_marker(self.grid, marker)[1]
+
+    def body_orientation(self, body: str, sequence: str = "xyz") -> cs.MX:
+        return self._q.orientation(self.grid, body, check_sequence(sequence))
+
+    def tracked_body_orientation(self, body: str, sequence: str = "xyz") -> cs.MX:
+        return self._q.tracked_orientation(self.grid, body, check_sequence(sequence))
+
+    # ---- controls and muscles ------------------------------------------------------------
+    def control(self, name: str) -> cs.MX:
+        return self._q.control(self.grid, name)
+
+    def initial_control(self, name: str) -> cs.MX:
+        return self._q.initial_control(self.grid, name)
+
+    def muscle_activations(self) -> cs.MX:
+        """(n, M) activations of :attr:`TreatmentContext.muscle_names`."""
+        return self._q.muscle_activations(self.grid)
+
+    def muscle_activation(self, muscle: str) -> cs.MX:
+        return self.muscle_activations()[:, self._q.muscle_index(muscle)]
+
+    def tracked_muscle_activation(self, muscle: str) -> cs.MX:
+        return self._q.tracked_activation(self.grid, muscle)
+
+    def normalized_fiber_length(self, muscle: str) -> cs.MX:
+        return self._q.muscle_quantity(self.grid, "normalized_fiber_length")[:, self._q.muscle_index(muscle)]
+
+    # ---- generic caching for extensions -------------------------------------------------------
+    def cached(self, key: str, compute: Callable[[GridView], cs.MX]) -> cs.MX:
+        """``compute(self)`` once per grid and ``key`` (for quantities added by plugins)."""
+        return self._q.cache((self.grid, "plugin", key), lambda: compute(self))
+
+
+class TreatmentContext(GridView):
+    """What terms receive: the collocation-point view, terminal views and problem-wide data."""
+
+    def __init__(self, quantities: _Quantities) -> None:
+        super().__init__(quantities, quantities.trajectory.integration_grid)
+        self.tool = quantities.data.tool
+        self.initial = GridView(quantities, "initial")
+        self.final = GridView(quantities, "final")
+
+    def at(self, grid: str) -> GridView:
+        """View of another grid (``nodes``, ``collocation``, ``initial``, ``final``)."""
+        return GridView(self._q, grid)
+
+    # ---- problem-wide -------------------------------------------------------------------------
+    @property
+    def model(self) -> TreatmentModel:
+        return self._q.data.model
+
+    @property
+    def final_time(self) -> cs.MX:
+        return self._q.trajectory.final_time
+
+    @property
+    def reference_duration(self) -> float:
+        """Duration (s) of the tracked data the references are sampled from."""
+        return self._q.data.reference_duration
+
+    @property
+    def state_coordinates(self) -> tuple[str, ...]:
+        return self._q.data.state_coordinates
+
+    def is_actuated(self, coordinate: str) -> bool:
+        """True when a controller applies loads on ``coordinate``."""
+        return any(coordinate in c.controlled_coordinates() for c in self._q.data.controllers)
+
+    @property
+    def controller_names(self) -> tuple[str, ...]:
+        return tuple(self._q.control_lookup)
+
+    @property
+    def muscle_names(self) -> tuple[str, ...]:
+        return self._q.muscle_names
+
+    def parameter(self, name: str) -> cs.MX:
+        try:
+            return self._q.data.parameters[name]
+        except KeyError:
+            raise KeyError(f"no static parameter '{name}' (have: {', '.join(self._q.data.parameters) or 'none'})") from None
+
+    def synergy_weights(self, group: str | None = None) -> cs.MX:
+        return self._q.synergy_weights(group, initial=False)
+
+    def initial_synergy_weights(self, group: str | None = None) -> np.ndarray:
+        return self._q.synergy_weights(group, initial=True)
+
+    def differentiate(self, values: Any) -> cs.MX:
+        """Time derivative (per second) of (K, m) collocation values through each interval's
+        interpolating polynomial on its collocation points (an interval with one point: 0)."""
+        return self._q.collocation_derivative() @ cs.MX(values) / self.final_time
+
+    def integrate(self, values: Any) -> cs.MX:
+        """``integral_0^1 values ds`` over normalized time of (K, m) values -> (1, m)."""
+        w = cs.DM(self._q.trajectory.quadrature_weights).T
+        return w @ cs.MX(values)
+
+    # ---- reductions (called by the term bases) ------------------------------------------------
+    def _range_mask(self, time_ranges: Sequence[float] | None, grid: str) -> np.ndarray:
+        s = self._q.trajectory.normalized_times(grid)
+        if not time_ranges:
+            return np.ones(s.size, dtype=bool)
+        mask = np.zeros(s.size, dtype=bool)
+        for a, b in zip(time_ranges[::2], time_ranges[1::2]):
+            mask |= (s >= a - 1e-12) & (s <= b + 1e-12)
+        return mask
+
+    def reduce_cost(self, term: CostTerm, normalized: Any) -> Any:
+        if getattr(term, "discrete", False):
+            z = cs.MX(normalized)
+            if z.numel() != 1:
+                raise term.error(f"a discrete cost must be a scalar, got shape {z.shape}")
+            return z
+        z = cs.MX(normalized)
+        if z.shape != (self.n, 1):
+            raise term.error(f"a continuous cost must be a ({self.n}, 1) column on the collocation points, got {z.shape}")
+        weights = self._q.trajectory.quadrature_weights * self._range_mask(getattr(term, "time_ranges", None), self.grid)
+        residuals = reductions.quadrature(z, weights)
+        if not getattr(term, "normalize_by_final_time", True):
+            residuals = residuals * cs.sqrt(self.final_time)
+        return residuals
+
+    def reduce_constraint(self, term: ConstraintTerm, value: Any) -> tuple[Any, Any, Any]:
+        v = cs.MX(value)
+        if getattr(term, "terminal", False):
+            if v.numel() != 1:
+                raise term.error(f"a terminal constraint must be a scalar, got shape {v.shape}")
+        else:
+            if v.shape != (self.n, 1):
+                raise term.error(f"a path constraint must be a ({self.n}, 1) column, got {v.shape}")
+            rows = np.flatnonzero(self._range_mask(getattr(term, "time_ranges", None), self.grid))
+            v = v[rows.tolist(), 0]
+        lo, hi = float(term.min_error), float(term.max_error)
+        span = hi - lo
+        mid = 0.5 * (hi + lo)
+        if span <= 0:
+            return v - mid, 0.0, 0.0
+        return (v - mid) / span, -0.5, 0.5
+
+    # ---- name checks ------------------------------------------------------------------------
+    def require_coordinate(self, term: Any, name: str, element: str = "<coordinate_list>") -> None:
+        if name not in self._q.coordinate_position:
+            raise term.error(f"coordinate '{name}' is not in the model", element=element,
+                             expected="one of " + ", ".join(self._q.data.model.coordinate_names))
+
+    def require_state_coordinate(self, term: Any, name: str, element: str = "<coordinate_list>") -> None:
+        self.require_coordinate(term, name, element)
+        if name not in self._q.data.state_coordinates:
+            raise term.error(f"coordinate '{name}' is not in <states_coordinate_list>", element=element,
+                             expected="one of " + ", ".join(self._q.data.state_coordinates))
+
+    def require_load(self, term: Any, load: str, element: str = "<load_list>") -> None:
+        try:
+            self._q.load_index(load)
+        except KeyError:
+            labels = [self._q.data.model.load_label(c) for c in self._q.data.model.coordinate_names]
+            raise term.error(f"load '{load}' is not an inverse-dynamics load of the model", element=element,
+                             expected="one of " + ", ".join(labels)) from None
+
+    def require_tracked_load(self, term: Any, load: str, element: str = "<load_list>") -> None:
+        self.require_load(term, load, element)
+        refs = self._q.data.references.get("loads")
+        if refs is None or self._q.tracked_load_label(load) is None:
+            have = ", ".join(refs.labels) if refs is not None else "no IDData file"
+            raise term.error(f"load '{load}' has no column in the tracked inverse dynamics (IDData)",
+                             element=element, expected=f"one of: {have}")
+
+    def require_marker(self, term: Any, marker: str, element: str = "<marker_list>") -> None:
+        if marker not in self._q.data.model.marker_names:
+            raise term.error(f"marker '{marker}' is not in the model", element=element,
+                             expected="one of " + ", ".join(self._q.data.model.marker_names))
+
+    def require_body(self, term: Any, body: str, element: str = "<body_list>") -> None:
+        if body not in self._q.data.model.body_names:
+            raise term.error(f"body '{body}' is not in the model", element=element,
+                             expected="one of " + ", ".join(self._q.data.model.body_names))
+
+    def require_control(self, term: Any, name: str, element: str = "<controller_list>") -> None:
+        if name not in self._q.control_lookup:
+            raise term.error(f"'{name}' is not a control of this problem's controllers", element=element,
+                             expected="one of " + ", ".join(self._q.control_lookup))
+
+    def require_muscle(self, term: Any, muscle: str, element: str = "<muscle_list>") -> None:
+        if muscle not in self._q.muscle_names:
+            raise term.error(f"muscle '{muscle}' is not driven by a synergy or muscle controller", element=element,
+                             expected="one of " + (", ".join(self._q.muscle_names) or "(no muscle controller)"))
+
+    def require_tracked_activation(self, term: Any, muscle: str, element: str = "<muscle_list>") -> None:
+        self.require_muscle(term, muscle, element)
+        refs = self._q.data.references.get("activations")
+        if refs is None or not refs.has(muscle):
+            raise term.error(f"no reference activation for muscle '{muscle}' (<trial>_combinedActivations.sto "
+                             "in the initial guess directory)", element=element)
+
+    def require_parameter(self, term: Any, name: str, element: str = "<type>") -> None:
+        if name not in self._q.data.parameters:
+            raise term.error(f"static parameter '{name}' is not declared in <RCNLParameterTermSet>", element=element,
+                             expected="one of " + (", ".join(self._q.data.parameters) or "(none declared)"))
+
+
+class _Quantities:
+    """Lazy, cached evaluation of every quantity of the context (internal)."""
+
+    def __init__(self, data: TreatmentData, trajectory: Trajectory, parallel: int = 1) -> None:
+        self.data = data
+        self.trajectory = trajectory
+        self.parallel = parallel
+        self._cache: dict[Any, Any] = {}
+        model = data.model
+        self.coordinate_position = {c: i for i, c in enumerate(model.coordinate_names)}
+        self.load_position = {model.load_label(c): i for i, c in enumerate(model.coordinate_names)}
+        # controls: user-facing name -> (controller, internal control column name)
+        self.control_lookup: dict[str, tuple[Any, str]] = {}
+        for controller in data.controllers:
+            for spec in controller.control_specs():
+                for alias in (spec.name, *spec.aliases):
+                    self.control_lookup.setdefault(alias, (controller, spec.name))
+        names: list[str] = []
+        for controller in data.controllers:
+            names.extend(m for m in controller.muscle_names() if m not in names)
+        self.muscle_names = tuple(names)
+
+    def cache(self, key: Any, compute: Callable[[], Any]) -> Any:
+        if key not in self._cache:
+            self._cache[key] = compute()
+        return self._cache[key]
+
+    # ---- indices ---------------------------------------------------------------------------
+    def coordinate_index(self, name: str) -> int:
+        try:
+            return self.coordinate_position[name]
+        except KeyError:
+            raise KeyError(f"coordinate '{name}' is not in the model") from None
+
+    def load_coordinate(self, load: str) -> str:
+        if load in self.coordinate_position:
+            return load
+        if load in self.load_position:
+            return self.data.model.coordinate_names[self.load_position[load]]
+        raise KeyError(f"load '{load}' is not an inverse-dynamics load of the model")
+
+    def load_index(self, load: str) -> int:
+        return self.coordinate_position[self.load_coordinate(load)]
+
+    def muscle_index(self, muscle: str) -> int:
+        try:
+            return self.muscle_names.index(muscle)
+        except ValueError:
+            raise KeyError(f"muscle '{muscle}' is not driven by a controller") from None
+
+    # ---- time bases ----------------------------------------------------------------------
+    def reference_times(self, grid: str) -> np.ndarray:
+        """Times (s) at which references are sampled: normalized time x reference duration."""
+        return self.trajectory.normalized_times(grid) * self.data.reference_duration
+
+    def time_ratio(self) -> Any:
+        """``T_ref / t_f``: derivative factor of signals following normalized time."""
+        tf = self.trajectory.final_time
+        if not self.data.free_final_time:
+            return self.data.reference_duration / float(self.data.final_time_guess)
+        return self.data.reference_duration / tf
+
+    def collocation_derivative(self) -> cs.DM:
+        """(K, K) d/ds of the per-interval polynomial through the collocation values."""
+        def compute() -> cs.DM:
+            from nmsm.tools.treatment.transcription.radau import differentiation_matrix, radau_rule
+
+            mesh = self.trajectory.phase.mesh
+            D = np.zeros((mesh.n_collocation, mesh.n_collocation))
+            for i, n in enumerate(mesh.points):
+                idx = mesh.interval_node_indices(i)[:-1]
+                if n > 1:
+                    D[np.ix_(idx, idx)] = differentiation_matrix(radau_rule(n).collocation) * (2.0 / mesh.fractions[i])
+            return cs.DM(D)
+        return self.cache(("collocation_derivative",), compute)
+
+    # ---- kinematics ----------------------------------------------------------------------
+    def kinematics(self, grid: str) -> tuple[cs.MX, cs.MX, cs.MX]:
+        def compute() -> tuple[cs.MX, cs.MX, cs.MX]:
+            q, qd, qdd = self.map_point(self._full_kinematics_function(), grid)
+            return q, qd, qdd
+        return self.cache((grid, "kinematics"), compute)
+
+    def _point_inputs(self, grid: str) -> tuple[cs.MX, cs.DM, Any]:
+        """Per-row inputs of point functions: ``(V (n, 3 n_s) [q_s, q̇_s, q̈_s] variables,
+        C (n, 3 n_p) [q_p, q̇_p, q̈_p] prescribed values on the reference time base,
+        ratio T_ref / t_f)``."""
+        def compute() -> tuple[cs.MX, cs.DM, Any]:
+            data = self.data
+            states = self.trajectory.states(grid)
+            controls = self.trajectory.controls(grid)
+            n_s = len(data.state_coordinates)
+            off = data.acceleration_control_offset
+            V = cs.horzcat(states[:, :n_s], states[:, n_s:2 * n_s], controls[:, off:off + n_s])
+            prescribed = self.prescribed_coordinates
+            if prescribed:
+                t = self.reference_times(grid)
+                C = cs.DM(np.hstack([data.prescribed.values(t, order, prescribed) for order in range(3)]))
+            else:
+                C = cs.DM(self.trajectory.grid_size(grid), 0)
+            return V, C, self.time_ratio()
+        return self.cache((grid, "point_inputs"), compute)
+
+    @property
+    def prescribed_coordinates(self) -> tuple[str, ...]:
+        return tuple(c for c in self.data.model.independent_coordinates if c not in self.data.state_coordinates)
+
+    def _full_kinematics_function(self) -> cs.Function:
+        """SX ``(v, c, ratio) -> (q, q̇, q̈)`` of all coordinates for one point."""
+        def compute() -> cs.Function:
+            data, model = self.data, self.data.model
+            n_s = len(data.state_coordinates)
+            prescribed = self.prescribed_coordinates
+            n_p = len(prescribed)
+            v = cs.SX.sym("v", 3 * n_s)
+            c = cs.SX.sym("c", 3 * n_p)
+            ratio = cs.SX.sym("ratio")
+            cols: tuple[list, list, list] = ([], [], [])
+            for name in model.independent_coordinates:
+                if name in data.state_coordinates:
+                    i = data.state_coordinates.index(name)
+                    cols[0].append(v[i])
+                    cols[1].append(v[n_s + i])
+                    cols[2].append(v[2 * n_s + i])
+                else:
+                    j = prescribed.index(name)
+                    cols[0].append(c[j])
+                    cols[1].append(c[n_p + j] * ratio)
+                    cols[2].append(c[2 * n_p + j] * ratio**2)
+            qi, qdi, qddi = (cs.vertcat(*col) for col in cols)
+            if tuple(model.independent_coordinates) == tuple(model.coordinate_names):
+                q, qd, qdd = qi, qdi, qddi
+            else:
+                q, qd, qdd = model.expand_function()(qi, qdi, qddi)
+            return cs.Function("full_kinematics", [v, c, ratio], [q, qd, qdd])
+        return self.cache(("full_kinematics_function",), compute)
+
+    def composed(self, key: Any, function: cs.Function, uses: str = "q, qd, qdd") -> cs.Function:
+        """``function`` of full kinematics turned into an SX point function of
+        ``(v, c, ratio)`` (see :meth:`_point_inputs`), so derivatives only span the
+        variables. ``uses``: which of q, qd, qdd ``function`` takes, in that order."""
+        def compute() -> cs.Function:
+            full = self._full_kinematics_function()
+            v, c, ratio = (cs.SX.sym(n, full.size1_in(i)) for i, n in enumerate(("v", "c", "ratio")))
+            q, qd, qdd = full(v, c, ratio)
+            args = {"q": q, "qd": qd, "qdd": qdd}
+            outs = function.call([args[k.strip()] for k in uses.split(",")])
+            return cs.Function(f"point_{function.name()}", [v, c, ratio], outs)
+        return self.cache(("composed", key), compute)
+
+    def map_point(self, function: cs.Function, grid: str) -> list[cs.MX]:
+        """Evaluate an SX point function of ``(v, c, ratio)`` on every row of ``grid``."""
+        V, C, ratio = self._point_inputs(grid)
+        return map_rows(function, V, C, cs.MX(ratio) if not isinstance(ratio, float) else cs.DM(ratio),
+                        parallel=self.parallel)
+
+    def tracked_kinematics(self, grid: str, order: int) -> cs.DM:
+        def compute() -> cs.DM:
+            values = self.data.tracked_full_kinematics(self.reference_times(grid))
+            return cs.DM(values[order])
+        return self.cache((grid, "tracked_kinematics", order), compute)
+
+    # ---- inverse dynamics -------------------------------------------------------------------
+    def inverse_dynamics(self, grid: str) -> cs.MX:
+        def compute() -> cs.MX:
+            f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
+            (tau,) = self.map_point(f, grid)
+            return tau
+        return self.cache((grid, "inverse_dynamics"), compute)
+
+    def tracked_load_label(self, load: str) -> str | None:
+        refs = self.data.references.get("loads")
+        if refs is None:
+            return None
+        coord = self.load_coordinate(load)
+        for label in (load, self.data.model.load_label(coord), coord):
+            if refs.has(label):
+                return label
+        return None
+
+    def tracked_loads(self, grid: str, load: str) -> cs.DM:
+        label = self.tracked_load_label(load)
+        if label is None:
+            raise KeyError(f"load '{load}' has no column in the tracked inverse dynamics")
+        refs = self.data.references["loads"]
+        return self.cache((grid, "tracked_load", label),
+                          lambda: cs.DM(refs.values(self.reference_times(grid), 0, [label])))
+
+    def controller_load(self, grid: str, coordinate: str) -> cs.MX:
+        def compute() -> cs.MX:
+            total: cs.MX | None = None
+            view = GridView(self, grid)
+            for controller in self.data.controllers:
+                loads = self.cache((grid, "controller_loads", id(controller)), lambda c=controller: c.applied_loads(view))
+                if coordinate in loads:
+                    total = loads[coordinate] if total is None else total + loads[coordinate]
+            if total is None:
+                return cs.MX(self.trajectory.grid_size(grid), 1)
+            return total
+        return self.cache((grid, "controller_load", coordinate), compute)
+
+    # ---- markers and bodies -------------------------------------------------------------------
+    def _marker_functions(self, marker: str) -> cs.Function:
+        def compute() -> cs.Function:
+            f = self.data.model.marker_function(marker)
+            nq = len(self.data.model.coordinate_names)
+            q = cs.SX.sym("q", nq)
+            qd = cs.SX.sym("qd", nq)
+            p = f(q)
+            v = cs.jtimes(p, q, qd)
+            return cs.Function(f"marker_{marker}", [q, qd], [p, v])
+        return self.cache(("marker_function", marker), compute)
+
+    def marker(self, grid: str, marker: str) -> tuple[cs.MX, cs.MX]:
+        def compute() -> tuple[cs.MX, cs.MX]:
+            f = self.composed(("marker", marker), self._marker_functions(marker), "q, qd")
+            p, v = self.map_point(f, grid)
+            return p, v
+        return self.cache((grid, "marker", marker), compute)
+
+    def tracked_marker(self, grid: str, marker: str) -> tuple[cs.DM, cs.DM]:
+        def compute() -> tuple[cs.DM, cs.DM]:
+            q, qd, _ = self.data.tracked_full_kinematics(self.reference_times(grid))
+            f = self._marker_functions(marker).map(q.shape[0])
+            p, v = f(cs.DM(q).T, cs.DM(qd).T)
+            return cs.DM(p).T, cs.DM(v).T
+        return self.cache((grid, "tracked_marker", marker), compute)
+
+    def _orientation_function(self, body: str, sequence: str) -> cs.Function:
+        def compute() -> cs.Function:
+            nq = len(self.data.model.coordinate_names)
+            q = cs.SX.sym("q", nq)
+            R = self.data.model.body_rotation_function(body)(q)
+            return cs.Function(f"orientation_{body}_{sequence}", [q], [cs.vertcat(*euler_angles(R, sequence))])
+        return self.cache(("orientation_function", body, sequence), compute)
+
+    def orientation(self, grid: str, body: str, sequence: str) -> cs.MX:
+        def compute() -> cs.MX:
+            f = self.composed(("orientation", body, sequence), self._orientation_function(body, sequence), "q")
+            (angles,) = self.map_point(f, grid)
+            return angles
+        return self.cache((grid, "orientation", body, sequence), compute)
+
+    def tracked_orientation(self, grid: str, body: str, sequence: str) -> cs.DM:
+        def compute() -> cs.DM:
+            q, _, _ = self.data.tracked_full_kinematics(self.reference_times(grid))
+            f = self._orientation_function(body, sequence).map(q.shape[0])
+            return cs.DM(f(cs.DM(q).T)).T
+        return self.cache((grid, "tracked_orientation", body, sequence), compute)
+
+    # ---- controls -----------------------------------------------------------------------------
+    def _lookup(self, name: str) -> tuple[Any, str]:
+        try:
+            return self.control_lookup[name]
+        except KeyError:
+            raise KeyError(f"'{name}' is not a control (have: {', '.join(self.control_lookup)})") from None
+
+    def control(self, grid: str, name: str) -> cs.MX:
+        _, internal = self._lookup(name)
+        return self.trajectory.control(internal, grid)
+
+    def initial_control(self, grid: str, name: str) -> cs.DM:
+        controller, internal = self._lookup(name)
+        return self.cache((grid, "initial_control", internal),
+                          lambda: cs.DM(controller.control_reference(internal, self.reference_times(grid))))
+
+    def muscle_activations(self, grid: str) -> cs.MX:
+        def compute() -> cs.MX:
+            view = GridView(self, grid)
+            parts = []
+            for controller in self.data.controllers:
+                names = controller.muscle_names()
+                if names:
+                    parts.append((names, controller.muscle_activations(view)))
+            n = self.trajectory.grid_size(grid)
+            cols = []
+            for muscle in self.muscle_names:
+                col = None
+                for names, acts in parts:
+                    if muscle in names:
+                        part = acts[:, list(names).index(muscle)]
+                        col = part if col is None else col + part
+                cols.append(col if col is not None else cs.MX(n, 1))
+            return cs.horzcat(*cols) if cols else cs.MX(n, 0)
+        return self.cache((grid, "muscle_activations"), compute)
+
+    def muscle_quantity(self, grid: str, name: str) -> cs.MX:
+        def compute() -> cs.MX:
+            view = GridView(self, grid)
+            n = self.trajectory.grid_size(grid)
+            cols = {}
+            for controller in self.data.controllers:
+                values = controller.muscle_quantity(view, name)
+                if values is not None:
+                    for j, m in enumerate(controller.muscle_names()):
+                        cols.setdefault(m, values[:, j])
+            return cs.horzcat(*[cols.get(m, cs.MX(n, 1)) for m in self.muscle_names]) if self.muscle_names else cs.MX(n, 0)
+        return self.cache((grid, "muscle_quantity", name), compute)
+
+    def tracked_activation(self, grid: str, muscle: str) -> cs.DM:
+        refs = self.data.references["activations"]
+        return self.cache((grid, "tracked_activation", muscle),
+                          lambda: cs.DM(refs.values(self.reference_times(grid), 0, [muscle])))
+
+    def synergy_weights(self, group: str | None, *, initial: bool) -> Any:
+        for controller in self.data.controllers:
+            getter = getattr(controller, "synergy_weight_matrix", None)
+            if getter is not None:
+                return getter(group, initial=initial)
+        raise KeyError("no synergy controller in this problem")

@@ -1,0 +1,121 @@
+"""Read a treatment problem's data folders (spec tools.md §8.1).
+
+``tracked_quantities_directory``: ``IKData/<trial>`` (required), ``IDData/<trial>``,
+``GRFData/<trial>`` (optional). ``initial_guess_directory``: optional ``IKData``/``IDData``
+and the files a previous TO/VO/DO wrote: ``<trial>_states.sto`` (``q``, ``q_u`` columns),
+``<trial>_accelerations.sto``, ``<trial>_torqueControls.sto``, ``<trial>_synergyCommands.sto``,
+``<trial>_combinedActivations.sto`` and ``synergyWeights.sto``. Tracked data come from the
+tracked folder, the initial kinematics from the initial-guess folder (falling back to the
+tracked ones). Times are shifted to start at 0; IK degrees become radians for the model's
+rotational coordinates only.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import attrs
+import numpy as np
+
+from nmsm.errors import InputError
+from nmsm.io.storage import COP_SUFFIXES, Table, read_storage
+from nmsm.io.trials import find_trial_file
+from nmsm.tools.treatment.model_interface import TreatmentModel
+
+#: initial-guess files written by a previous TO/VO/DO: kind -> file suffix
+RESULT_FILES = {
+    "states": "_states",
+    "accelerations": "_accelerations",
+    "torqueControls": "_torqueControls",
+    "synergyCommands": "_synergyCommands",
+    "combinedActivations": "_combinedActivations",
+}
+
+
+@attrs.define
+class TreatmentFiles:
+    """Tables of one trial (time from 0; kinematics in radians)."""
+
+    trial: str
+    tracked_ik: Table
+    tracked_id: Table | None
+    tracked_grf: Table | None
+    initial_ik: Table
+    initial_id: Table | None
+    results: dict[str, Table]
+    synergy_weights: Table | None
+    tracked_directory: Path
+    initial_directory: Path
+
+
+def _shift(table: Table) -> Table:
+    return attrs.evolve(table, time=table.time - table.time[0])
+
+
+def _optional_trial_table(folder: Path, trial: str, **kwargs) -> Table | None:
+    if not folder.is_dir():
+        return None
+    try:
+        path = find_trial_file(folder, trial)
+    except InputError:
+        return None
+    return _shift(read_storage(path, **kwargs))
+
+
+def _kinematics(table: Table, model: TreatmentModel) -> Table:
+    rotational = {c for c in model.coordinate_names if model.is_rotational(c)}
+    return table.to_radians(rotational)
+
+
+def _result_file(folder: Path, trial: str, suffix: str) -> Path | None:
+    exact = folder / f"{trial}{suffix}.sto"
+    if exact.is_file():
+        return exact
+    found = sorted(p for p in folder.glob(f"*{suffix}.sto") if trial in p.name)
+    if len(found) > 1:
+        raise InputError(f"several '{suffix}' files for trial '{trial}': {', '.join(p.name for p in found)}",
+                         file=folder, expected=f"one file named {trial}{suffix}.sto")
+    return found[0] if found else None
+
+
+def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model: TreatmentModel, *,
+                         settings_file: Path | None = None) -> TreatmentFiles:
+    """Read the tables of ``trial`` (see module docstring)."""
+    tracked_dir, initial_dir = Path(tracked_dir), Path(initial_dir)
+    ik_folder = tracked_dir / "IKData"
+    if not ik_folder.is_dir():
+        raise InputError(f"no IKData folder in the tracked quantities directory {tracked_dir}", file=settings_file,
+                         element="<tracked_quantities_directory>", expected="a folder holding IKData/<trial>.sto")
+    tracked_ik = _kinematics(_shift(read_storage(find_trial_file(ik_folder, trial))), model)
+    tracked_id = _optional_trial_table(tracked_dir / "IDData", trial)
+    tracked_grf = _optional_trial_table(tracked_dir / "GRFData", trial,
+                                        allow_nan=lambda label: label.endswith(COP_SUFFIXES))
+    initial_ik = _optional_trial_table(initial_dir / "IKData", trial)
+    initial_ik = _kinematics(initial_ik, model) if initial_ik is not None else tracked_ik
+    initial_id = _optional_trial_table(initial_dir / "IDData", trial)
+    if initial_id is None:
+        initial_id = tracked_id
+    results: dict[str, Table] = {}
+    if initial_dir.is_dir():
+        for kind, suffix in RESULT_FILES.items():
+            path = _result_file(initial_dir, trial, suffix)
+            if path is not None:
+                table = _shift(read_storage(path))
+                if kind in ("states", "accelerations") and table.in_degrees:
+                    table = _kinematics(table, model)
+                results[kind] = table
+    weights_path = initial_dir / "synergyWeights.sto"
+    synergy_weights = read_storage(weights_path) if weights_path.is_file() else None
+    for name, table in (("tracked IK", tracked_ik), ("initial IK", initial_ik)):
+        if table.n_rows < 2:
+            raise InputError(f"{name} has {table.n_rows} row(s)", file=table.source, expected="at least 2 time rows")
+    if tracked_id is None:
+        warnings.warn(f"{tracked_dir}: no IDData/{trial}: terms and torque controls needing tracked loads will fail",
+                      stacklevel=2)
+    return TreatmentFiles(trial, tracked_ik, tracked_id, tracked_grf, initial_ik, initial_id, results, synergy_weights,
+                          tracked_dir, initial_dir)
+
+
+def duration(table: Table) -> float:
+    return float(np.asarray(table.time)[-1] - np.asarray(table.time)[0])

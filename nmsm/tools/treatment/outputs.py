@@ -1,0 +1,73 @@
+"""Write a treatment solution as the original does (spec tools.md §8.4), on the ``nodes`` grid.
+
+Files (``<trial>`` = ``trial_name``):
+
+``IKData/<trial>.sto``                 every model coordinate (rad, m)
+``IDData/<trial>.sto``                 inverse dynamics of the solution (N·m, N), ID labels
+``<trial>_states.sto``                 ``q`` and ``q_u`` of the state coordinates
+``<trial>_accelerations.sto``          ``q̈`` of the state coordinates
+``<trial>_torqueControls.sto`` ...     each controller's tables (torque controls, synergy
+                                       commands, synergy weights, combined activations)
+``<trial>_parameterSolution.xml``      DO static parameters (when any)
+``<trial>_convergence.txt``            IPOPT status, cost per term, active/violated constraints
+``Analysis/<trial>_trackedPositions.sto`` / ``_modeledPositions.sto`` etc.: tracked and
+                                       modeled state kinematics on the same times
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from nmsm.io.storage import table_from_columns, write_storage
+from nmsm.tools.treatment.formulation import speed_label
+from nmsm.tools.treatment.solution import TreatmentSolution
+
+
+def write_table(path: Path, time: np.ndarray, labels: Sequence[str], values: np.ndarray, name: str = "") -> Path:
+    """Write ``values`` (n, k) with ``labels`` and ``time`` (n,) as an OpenSim table."""
+    values = np.asarray(values, dtype=float).reshape(len(time), len(labels))
+    table = table_from_columns(time, {label: values[:, j] for j, label in enumerate(labels)}, name=name or path.stem)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return write_storage(path, table)
+
+
+def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None = None,
+                   extra_tables: Mapping[str, tuple[Sequence[str], np.ndarray]] | None = None) -> list[Path]:
+    """Write every output file of ``tsol`` into ``stage``; returns the paths."""
+    built = tsol.built
+    data = built.data
+    model = data.model
+    trial = tsol.trial_name
+    t = tsol.time
+    coords = model.coordinate_names
+    out = [
+        write_table(stage / "IKData" / f"{trial}.sto", t, coords, tsol.positions),
+        write_table(stage / "IDData" / f"{trial}.sto", t, [model.load_label(c) for c in coords], tsol.inverse_dynamics),
+    ]
+    sc = data.state_coordinates
+    out.append(write_table(stage / f"{trial}_states.sto", t, list(sc) + [speed_label(c) for c in sc], tsol.states))
+    out.append(write_table(stage / f"{trial}_accelerations.sto", t, sc, tsol.state_accelerations))
+    tables: dict[str, tuple[Sequence[str], np.ndarray]] = {}
+    for controller in data.controllers:
+        tables.update(controller.output_tables(tsol))
+    tables.update(extra_tables or {})
+    for name, (labels, values) in tables.items():
+        values = np.asarray(values, dtype=float)
+        time = t if values.shape[0] == t.size else np.arange(values.shape[0], dtype=float)
+        out.append(write_table(stage / name, time, labels, values))
+    # tracked vs modeled kinematics of the states, on the same times
+    ref_t = tsol.view.normalized_time * data.reference_duration
+    tracked = data.tracked_full_kinematics(ref_t)
+    idx = [coords.index(c) for c in sc]
+    for kind, modeled, reference in (("Positions", tsol.positions, tracked[0]), ("Velocities", tsol.speeds, tracked[1]),
+                                     ("Accelerations", tsol.accelerations, tracked[2])):
+        out.append(write_table(stage / "Analysis" / f"{trial}_modeled{kind}.sto", t, sc, modeled[:, idx]))
+        out.append(write_table(stage / "Analysis" / f"{trial}_tracked{kind}.sto", t, sc, reference[:, idx]))
+    if summary is not None:
+        path = stage / f"{trial}_convergence.txt"
+        path.write_text(summary + "\n", encoding="utf-8")
+        out.append(path)
+    return out

@@ -1,0 +1,213 @@
+"""``nmsm run`` for TO, VO and DO settings files: :func:`run_settings`.
+
+    from nmsm.tools.treatment.run import run_settings
+    run = run_settings("TorqueTOSettingsV1.xml", results_directory="out/TO1")
+    print(run.summary)
+
+Options (keyword arguments) are the fields of
+:class:`~nmsm.tools.treatment.tool.TreatmentOptions`: directory overrides
+(``results_directory``, ``initial_guess_directory``, ``tracked_quantities_directory``,
+``guess_directory``), IPOPT overrides (``max_iterations``, ``tolerance``, ``hessian``,
+``linear_solver``, ``print_level``, ``ipopt_options``), ``parallel``, ``evaluate_only``
+(return the cost of the starting point without solving) and ``write_results``.
+
+Results are staged and moved into the results folder only when the solve succeeded. A
+failed solve writes its last iterate and a diagnosis into ``<results>/last_iterate/`` and
+raises :class:`~nmsm.errors.SolverError`.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import Any
+
+import attrs
+
+from nmsm.core.problem import Solution
+from nmsm.core.results import ResultsDirectory
+from nmsm.errors import InputError, SolverError
+from nmsm.tools.treatment.diagnosis import convergence_summary
+from nmsm.tools.treatment.solution import TreatmentSolution
+from nmsm.tools.treatment.tool import Prepared, TreatmentOptions, prepare
+
+
+@attrs.define
+class TreatmentRun:
+    """What a run produced."""
+
+    prepared: Prepared
+    solution: Solution
+    result: TreatmentSolution
+    summary: str
+    initial_cost: float
+    results_directory: Path | None
+    files: list[Path]
+    build_time: float
+
+    @property
+    def cost(self) -> float:
+        return self.solution.cost
+
+
+def load_settings(path: str | os.PathLike[str]) -> tuple[Any, Any]:
+    """(tool settings, solver settings) of a TO/VO/DO settings file."""
+    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.solver import OptimalControlSolverSettings
+    from nmsm.io.settings.treatment import (
+        DesignOptimizationSettings,
+        TrackingOptimizationSettings,
+        VerificationOptimizationSettings,
+    )
+
+    classes = {
+        "TrackingOptimizationTool": TrackingOptimizationSettings,
+        "VerificationOptimizationTool": VerificationOptimizationSettings,
+        "DesignOptimizationTool": DesignOptimizationSettings,
+    }
+    doc = read_settings_document(path)
+    cls = classes.get(doc.tool)
+    if cls is None:
+        raise InputError(f"<{doc.tool}> is not a treatment optimization tool", file=path,
+                         expected="<TrackingOptimizationTool>, <VerificationOptimizationTool> or <DesignOptimizationTool>")
+    settings = cls.from_document(doc)
+    solver_doc = read_settings_document(settings.optimal_control_solver_settings_file)
+    return settings, OptimalControlSolverSettings.from_document(solver_doc)
+
+
+def _options(kwargs: dict[str, Any]) -> TreatmentOptions:
+    fields = {f.name for f in attrs.fields(TreatmentOptions)}
+    unknown = set(kwargs) - fields
+    if unknown:
+        raise TypeError(f"unknown run_settings options: {', '.join(sorted(unknown))} (valid: {', '.join(sorted(fields))})")
+    values = dict(kwargs)
+    for key in ("results_directory", "initial_guess_directory", "tracked_quantities_directory", "guess_directory"):
+        if values.get(key) is not None:
+            values[key] = Path(values[key])
+    return TreatmentOptions(**values)
+
+
+def objective_scaling_factor(options: TreatmentOptions, initial_cost: float) -> float | None:
+    """IPOPT ``obj_scaling_factor`` for ``options.objective_scaling`` (see TreatmentOptions)."""
+    mode = options.objective_scaling
+    if isinstance(mode, (int, float)):
+        return float(mode)
+    if mode == "none":
+        return None
+    if mode != "initial":
+        raise ValueError(f"objective_scaling must be 'initial', 'none' or a number, got {mode!r}")
+    if not initial_cost > 0:
+        return None
+    return float(min(max(1.0 / initial_cost, 1e-6), 1e6))
+
+
+def _ipopt_kwargs(prepared: Prepared, options: TreatmentOptions, log: Path | None,
+                  initial_cost: float = 1.0) -> dict[str, Any]:
+    plan = dict(prepared.plan.ipopt)
+    extra = dict(options.ipopt_options)
+    factor = objective_scaling_factor(options, initial_cost)
+    if factor is not None:
+        extra.setdefault("obj_scaling_factor", factor)
+    if log is not None:
+        extra.setdefault("output_file", str(log))
+        extra.setdefault("file_print_level", 5)
+    return {
+        "max_iter": options.max_iterations or plan["max_iter"],
+        "tol": options.tolerance or plan["tol"],
+        "linear_solver": options.linear_solver or plan["linear_solver"],
+        "print_level": plan["print_level"] if options.print_level is None else options.print_level,
+        "hessian": options.hessian,
+        "ipopt_options": extra,
+    }
+
+
+def _results_directory(settings: Any, options: TreatmentOptions, inputs: list[Path]) -> ResultsDirectory:
+    path = Path(options.results_directory or settings.results_directory)
+    try:
+        return ResultsDirectory(path, inputs=inputs)
+    except OSError as exc:
+        raise InputError(f"cannot create the results folder {path}: {exc.strerror or exc}",
+                         file=settings.settings_file, element="<results_directory>",
+                         expected="a writable folder (pass results_directory= to write elsewhere)") from exc
+
+
+def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
+    """Run the TO, VO or DO settings file ``path`` (see module docstring)."""
+    opts = _options(options)
+    settings, solver_settings = load_settings(path)
+    start = time.perf_counter()
+    declare_extra = None
+    if settings.tool_code == "DO":
+        from nmsm.tools.treatment.design import design_extras
+
+        declare_extra = design_extras(settings)
+    prepared = prepare(settings, solver_settings, opts, declare_extra=declare_extra)
+    build_time = time.perf_counter() - start
+    problem = prepared.built.problem
+    x0 = problem.initial_scaled()
+    lo, hi = problem.bounds_scaled()
+    import numpy as np
+
+    x0 = np.clip(x0, lo, hi)
+    initial_cost = float(np.asarray(problem.evaluate(problem.objective(), x0)).ravel()[0])
+    trial = settings.trial_name
+    if opts.evaluate_only:
+        solution = Solution(problem.unpack(x0), initial_cost, problem.term_costs(x0), False, "not solved (evaluate_only)",
+                            0, 0.0, "none", x0, problem.constraint_report(x0))
+        tsol = TreatmentSolution(prepared.built, solution, trial)
+        return TreatmentRun(prepared, solution, tsol, convergence_summary(prepared.built, solution), initial_cost,
+                            None, [], build_time)
+    results = _results_directory(settings, opts, [Path(path), Path(settings.input_model_file)]) if opts.write_results else None
+    log_dir = Path(results.path) / ".ipopt" if results is not None else None
+    if log_dir is not None:
+        log_dir.mkdir(parents=True, exist_ok=True)
+    log = log_dir / f"{trial}_ipopt.log" if log_dir is not None else None
+    solution = problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
+    tsol = TreatmentSolution(prepared.built, solution, trial)
+    summary = convergence_summary(prepared.built, solution)
+    files: list[Path] = []
+    if not solution.success:
+        saved = None
+        if results is not None:
+            from nmsm.tools.treatment.outputs import write_solution
+
+            with results.task("last_iterate") as stage:
+                target = stage / "last_iterate"
+                write_solution(target, tsol, summary=summary)
+                (target / "diagnosis.txt").write_text(_diagnosis(prepared, solution, summary), encoding="utf-8")
+                if log is not None and log.is_file():
+                    shutil.copy2(log, target / log.name)
+            saved = str(Path(results.path) / "last_iterate")
+        raise SolverError(f"{settings.settings_file}: IPOPT did not converge ({solution.status} after "
+                          f"{solution.iterations} iterations)", last_iterate_path=saved)
+    if results is not None:
+        from nmsm.tools.treatment.design import parameter_tables, write_parameter_solution
+        from nmsm.tools.treatment.outputs import write_solution
+
+        with results.task(trial) as stage:
+            files = write_solution(stage, tsol, summary=summary, extra_tables=parameter_tables(prepared, tsol))
+            files += write_parameter_solution(stage, prepared, tsol)
+            shutil.copy2(path, stage / Path(path).name)
+            if log is not None and log.is_file():
+                shutil.copy2(log, stage / log.name)
+        files = [Path(results.path) / f.relative_to(stage) for f in files]
+        if log_dir is not None:
+            shutil.rmtree(log_dir, ignore_errors=True)
+    return TreatmentRun(prepared, solution, tsol, summary, initial_cost, Path(results.path) if results else None,
+                        files, build_time)
+
+
+def _diagnosis(prepared: Prepared, solution: Solution, summary: str) -> str:
+    hints = []
+    if solution.status == "Maximum_Iterations_Exceeded":
+        hints.append("IPOPT reached <setup_nlp_max_iterations>: raise it, or start from a better initial guess.")
+    if "Infeasible" in solution.status:
+        hints.append("IPOPT found the constraints locally infeasible: check the constraint bounds listed as VIOLATED "
+                     "below (min_error/max_error), the variable bounds (range scale factors) and the initial guess.")
+    if "Restoration" in solution.status:
+        hints.append("IPOPT's restoration phase failed: the problem may be infeasible or badly scaled near the guess.")
+    if prepared.warnings:
+        hints.append("Input warnings:\n  " + "\n  ".join(prepared.warnings))
+    return "Diagnosis\n=========\n" + ("\n".join(hints) + "\n\n" if hints else "") + summary + "\n"

@@ -1,0 +1,93 @@
+"""Plugin discovery through the ``nmsm`` entry-point group, duplicates, lookups."""
+
+from __future__ import annotations
+
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from nmsm.core.registry import build_registry, get_registry
+from nmsm.errors import RegistryError
+
+
+def _fake_distribution(root: Path, dist: str, module: str, body: str) -> None:
+    """An installed-looking distribution: a module plus a .dist-info with an nmsm entry point."""
+    (root / f"{module}.py").write_text(textwrap.dedent(body))
+    info = root / f"{dist}-1.2.3.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: 1.2.3\n")
+    (info / "entry_points.txt").write_text(f"[nmsm]\n{module} = {module}\n")
+
+
+_TERM_MODULE = """
+    from typing import ClassVar
+    import attrs
+    from nmsm.core.term import CostTerm
+    from nmsm.hookspecs import hookimpl
+
+    @attrs.frozen(kw_only=True)
+    class Dup(CostTerm):
+        '''A third-party term.'''
+        type: ClassVar[str] = "{name}"
+        tools: ClassVar[frozenset[str]] = frozenset({{"DO"}})
+
+    @hookimpl
+    def nmsm_cost_terms():
+        return [Dup]
+"""
+
+
+@pytest.fixture
+def extra_path(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(str(tmp_path))
+    yield tmp_path
+    for name in ("fake_plugin_a", "fake_plugin_b"):
+        sys.modules.pop(name, None)
+
+
+def test_builtin_plugins_come_from_the_nmsm_distribution() -> None:
+    items = get_registry().items()
+    assert {it.distribution for it in items if it.cls.__module__.startswith("nmsm.")} <= {"nmsm"}
+
+
+def test_third_party_term_is_discovered(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="fancy_goal"))
+    registry = build_registry()
+    cls = registry.get("cost", "fancy_goal", "DO")
+    (item,) = [it for it in registry.items("cost") if it.name == "fancy_goal"]
+    assert item.distribution == "fake-plugin-a" and item.version == "1.2.3"
+    assert cls.__doc__ == "A third-party term."
+
+
+def test_duplicate_name_names_both_distributions(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="same_goal"))
+    _fake_distribution(extra_path, "fake-plugin-b", "fake_plugin_b", _TERM_MODULE.format(name="same_goal"))
+    with pytest.raises(RegistryError) as info:
+        build_registry()
+    text = str(info.value)
+    assert "same_goal" in text and "fake-plugin-a" in text and "fake-plugin-b" in text
+
+
+def test_disable_plugins_env(extra_path: Path, monkeypatch) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="same_goal"))
+    _fake_distribution(extra_path, "fake-plugin-b", "fake_plugin_b", _TERM_MODULE.format(name="same_goal"))
+    monkeypatch.setenv("NMSM_DISABLE_PLUGINS", "fake-plugin-b")
+    registry = build_registry()
+    assert registry.get("cost", "same_goal", "DO").__module__ == "fake_plugin_a"
+
+
+def test_unknown_and_disallowed_names_list_valid_ones(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="fancy_goal"))
+    registry = build_registry()
+    with pytest.raises(RegistryError, match="unknown cost 'no_such_term' for DO. Valid cost names for DO: .*fancy_goal"):
+        registry.get("cost", "no_such_term", "DO")
+    with pytest.raises(RegistryError, match="not allowed in Tracking Optimization .*accepted by: DO"):
+        registry.get("cost", "fancy_goal", "TO")
+
+
+def test_broken_plugin_names_its_distribution(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", "raise ImportError('boom')\n")
+    with pytest.raises(RegistryError, match="fake-plugin-a.*failed to load.*boom"):
+        build_registry()
