@@ -26,6 +26,7 @@ Writing a term::
 
 from __future__ import annotations
 
+import itertools
 import typing
 import warnings
 from collections.abc import Mapping
@@ -159,17 +160,18 @@ class Term:
         """
         fields = cls.xml_fields()
         raw: dict[str, str] = {}
-        split_key: str | None = None
-        split_values: list[str] = []
+        # several lists (e.g. <marker_list> and <axes>) give one term per combination
+        splits: dict[str, list[str]] = {}
         for element, text in spec.fields.items():
             if element in ("type",):
                 continue
             target = cls.aliases.get(element, element)
             singular = LIST_TO_SINGULAR.get(target)
             if target not in fields and singular in fields:
-                split_key, split_values = singular, text.split()
+                split_values = text.split()
                 if singular == "axis":  # "xyz", "x z" or "x,y": one term per named axis
                     split_values = [c for c in text.lower() if c in "xyz"]
+                splits[singular] = split_values
                 continue
             if target not in fields:
                 raise InputError(
@@ -198,12 +200,11 @@ class Term:
                     line=spec.field_lines.get(key, spec.source.line),
                     expected=f"{getattr(fields[key], '__name__', fields[key])}",
                 ) from exc
-        items = split_values if split_key else [None]
+        keys = list(splits)
         out: list[Term] = []
-        for item in items:
+        for combination in itertools.product(*(splits[k] for k in keys)):
             kw = dict(values)
-            if split_key:
-                kw[split_key] = item
+            kw.update(zip(keys, combination))
             try:
                 out.append(cls(source=spec.source, **kw))
             except (TypeError, ValueError) as exc:

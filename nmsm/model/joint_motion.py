@@ -129,6 +129,40 @@ def _custom_simbody_motion(joint: Joint, q: cs.SX, u: cs.SX, s: cs.SX) -> tuple[
     return h_w, h_v, c_w, c_v
 
 
+_FIXED_AXIS_JOINTS = ("PinJoint", "SliderJoint", "UniversalJoint", "PlanarJoint", "GimbalJoint")
+
+
+def _fixed_axis_motion(kind: str, q: cs.SX, u: cs.SX) -> tuple[cs.SX, ...]:
+    """``(H_w, H_v, c_w, c_v)`` of the joints built from rotations about coordinate axes
+    (closed form: ``w = sum_i (R_0..R_(i-1) e_i) u_i``, so constant columns stay constant)."""
+    k = q.shape[0]
+    h_w = cs.SX.zeros(3, k)
+    h_v = cs.SX.zeros(3, k)
+    c_w = cs.SX.zeros(3, 1)
+    c_v = cs.SX.zeros(3, 1)
+    if kind == "PinJoint":
+        h_w[2, 0] = 1
+    elif kind == "SliderJoint":
+        h_v[0, 0] = 1
+    elif kind == "PlanarJoint":
+        h_w[2, 0] = 1
+        h_v[0, 1] = 1
+        h_v[1, 2] = 1
+    else:  # Universal (X then Y), Gimbal (X, Y, Z body-fixed)
+        axes = [_X, _Y, _Z][:k]
+        rotation = cs.SX.eye(3)
+        columns = []
+        for i, axis in enumerate(axes):
+            columns.append(cs.mtimes(rotation, cs.DM(axis)))
+            rotation = cs.mtimes(rotation, axis_angle(axis, q[i]))
+        h_w = cs.horzcat(*columns)
+        partial = cs.SX.zeros(3, 1)  # angular velocity of the intermediate frame
+        for i, column in enumerate(columns):
+            c_w = c_w + cs.cross(partial, column) * u[i]
+            partial = partial + column * u[i]
+    return h_w, h_v, c_w, c_v
+
+
 def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> cs.Function:
     """The SX Function described in the module docstring, for ``joint``.
 
@@ -154,6 +188,8 @@ def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> c
         c_v = cs.SX.zeros(3, 1)
     elif k and joint.type == "CustomJoint" and custom_joint_bias == "opensim":
         h_w, h_v, c_w, c_v = _custom_simbody_motion(joint, q, u, s)
+    elif joint.type in _FIXED_AXIS_JOINTS:
+        h_w, h_v, c_w, c_v = _fixed_axis_motion(joint.type, q, u)
     elif k:
         rotation_rate = cs.jtimes(rotation, q, u)
         w = vee(cs.mtimes(rotation_rate, rotation.T))

@@ -38,7 +38,6 @@ from typing import Any
 
 import attrs
 import numpy as np
-from scipy.interpolate import make_interp_spline
 
 from nmsm.errors import InputError, ModelError
 from nmsm.io.storage import Table, read_storage, write_storage
@@ -116,36 +115,24 @@ def motion_poses(model: Any, motion: Table) -> np.ndarray:
         )
     for name in present:
         q[:, names.index(name)] = table.column(name)
-    return couple_numeric(model, q)
+    if not model.coupled_coordinates:
+        return q
+    from nmsm.model.coordinates import CoordinateMap
 
-
-def couple_numeric(model: Any, q: np.ndarray) -> np.ndarray:
-    """``q`` ``(n, n_q)`` with dependent coordinates set by their couplers (numpy)."""
-    q = np.array(q, dtype=float)
-    names = model.coordinate_names
-    couplers = list(model.coupled_coordinates.values())
-    for _ in range(len(couplers)):
-        for c in couplers:
-            if len(c.independent) != 1:
-                raise ModelError(f"coupler with {len(c.independent)} independent coordinates is not supported",
-                                 file=model.file, element=f"CoordinateCouplerConstraint '{c.name}'",
-                                 expected="one independent coordinate")
-            x = q[:, names.index(c.independent[0])]
-            q[:, names.index(c.dependent)] = c.scale_factor * c.function.numeric(x, 0)
-    return q
+    return CoordinateMap(model).dependent_values(q)
 
 
 def coordinate_speeds(time: np.ndarray, q: np.ndarray) -> np.ndarray:
     """``dq/dt`` ``(n, k)`` of ``q`` ``(n, k)`` sampled at ``time`` ``(n,)`` (see module docstring)."""
+    from nmsm.model.signal import quintic_spline
+
     time = np.asarray(time, dtype=float)
     q = np.atleast_2d(np.asarray(q, dtype=float))
     if len(time) < 2:
         return np.zeros_like(q)
     if len(time) < 6:
         return np.gradient(q, time, axis=0)
-    natural = ([(3, 0.0), (4, 0.0)], [(3, 0.0), (4, 0.0)])
-    spline = make_interp_spline(time, q, k=5, bc_type=natural)
-    return spline.derivative()(time)
+    return quintic_spline(time, q, time)[1]
 
 
 # ---- engines ------------------------------------------------------------------------------
@@ -219,6 +206,7 @@ def analyze_motion(
     from nmsm.model.muscle_paths import has_active_wrapping
 
     sources: dict[str, str] = {}
+    uncovered = []
     for m in muscles:
         wraps = has_active_wrapping(model, model.muscle(m))
         if engine == "opensim":
@@ -230,8 +218,11 @@ def analyze_motion(
         elif engine == "auto":
             sources[m] = "opensim"
         else:
-            raise ModelError(f"muscle '{m}' wraps and the surrogate model does not cover it", file=model.file,
-                             element=f"muscle '{m}'", expected="a surrogate model including it, or engine 'opensim'/'auto'")
+            uncovered.append(m)
+    if uncovered:
+        raise ModelError(f"muscles with active wrapping not covered by the surrogate model: {', '.join(uncovered)}",
+                         file=model.file, element="muscles",
+                         expected="a surrogate model including them, or engine 'opensim' or 'auto'")
 
     n = table.n_rows
     lengths = np.zeros((n, len(muscles)))

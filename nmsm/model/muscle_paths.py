@@ -68,27 +68,13 @@ def has_active_wrapping(model: Model, muscle: Muscle) -> bool:
 
 
 def couple(model: Model, q: Any) -> Any:
-    """``q`` (SX/MX column, all coordinates) with dependent coordinates from their couplers.
-
-    Chained couplers (a dependent coordinate driving another coupler) settle after as
-    many passes as there are couplers.
-    """
-    couplers = list(model.coupled_coordinates.values())
-    if not couplers:
+    """``q`` (SX/MX column, all coordinates) with dependent coordinates from their couplers."""
+    if not model.coupled_coordinates:
         return q
-    index = {name: i for i, name in enumerate(model.coordinate_names)}
-    entries = [q[i] for i in range(len(index))]
-    for _ in range(len(couplers)):
-        for c in couplers:
-            if len(c.independent) != 1:
-                raise ModelError(
-                    f"coupler with {len(c.independent)} independent coordinates is not supported",
-                    file=model.file,
-                    element=f"CoordinateCouplerConstraint '{c.name}'",
-                    expected="one independent coordinate",
-                )
-            entries[index[c.dependent]] = c.scale_factor * c.function(entries[index[c.independent[0]]])
-    return cs.vertcat(*entries)
+    from nmsm.model.coordinates import CoordinateMap
+
+    coordinate_map = CoordinateMap(model)
+    return coordinate_map.expand_q(coordinate_map.independent(q))
 
 
 class _PoseCache:

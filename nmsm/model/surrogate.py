@@ -88,13 +88,18 @@ class GeometrySamples:
         """The samples at ``rows`` (indices or boolean mask)."""
         return attrs.evolve(self, q=self.q[rows], lengths=self.lengths[rows], moment_arms=self.moment_arms[rows])
 
-    def split(self, holdout_fraction: float, seed: int | None = 0) -> tuple[GeometrySamples, GeometrySamples]:
-        """Random split into (fitting, held-out) samples; ``holdout_fraction`` in [0, 1)."""
+    def split_rows(self, holdout_fraction: float, seed: int | None = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Row indices (sorted) of a random (fitting, held-out) split; ``holdout_fraction`` in [0, 1)."""
         if not 0.0 <= holdout_fraction < 1.0:
             raise ValueError(f"holdout_fraction must be in [0, 1), got {holdout_fraction}")
         order = np.random.default_rng(seed).permutation(self.n_poses)
         n_out = int(round(holdout_fraction * self.n_poses))
-        return self.subset(np.sort(order[n_out:])), self.subset(np.sort(order[:n_out]))
+        return np.sort(order[n_out:]), np.sort(order[:n_out])
+
+    def split(self, holdout_fraction: float, seed: int | None = 0) -> tuple[GeometrySamples, GeometrySamples]:
+        """Random split into (fitting, held-out) samples (see :meth:`split_rows`)."""
+        fit_rows, held_rows = self.split_rows(holdout_fraction, seed)
+        return self.subset(fit_rows), self.subset(held_rows)
 
 
 @attrs.frozen

@@ -43,7 +43,6 @@ NCP_TERMS = {
     "ActivationMinimization": "activation_minimization",
     "GroupedActivation": "grouped_activations",
     "GroupedNormalizedMuscleFiberLength": "grouped_fiber_lengths",
-    "BilateralSymmetry": "bilateral_symmetry",
 }
 
 

@@ -73,6 +73,10 @@ def upgrade(up: Upgrader) -> None:
     """0.1.0 ``<TrackingOptimizationTool>`` / ``Verification`` / ``Design`` -> current."""
     tool = next(elements(up.root))
     up.flatten_sets()
+    if tool.tag not in ("TrackingOptimizationTool", "VerificationOptimizationTool", "DesignOptimizationTool"):
+        up.note(tool, f"version {up.root.get('Version')} <{tool.tag}>: no known 0.x differences; read as current")
+        up.set_root(tool)
+        return
     _directories(up, tool)
     for old, new in (
         ("osimx_file", "input_osimx_file"),

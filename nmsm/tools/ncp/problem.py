@@ -9,6 +9,14 @@ Design variables (all >= 0, no upper bounds; tools.md §5):
 Activations ``a_t = (B @ nodes_t) @ W`` are bilinear in the variables and moments linear in
 activations, so the objective is a polynomial whose exact Hessian CasADi forms cheaply.
 Each free group's vectors sum to ``M_g/100`` (:class:`SynergyWeightSum`).
+
+Proximal term: with the settings' terms alone the activations can be undetermined (e.g.
+moment tracking only: infinitely many synergy sets give the same moments) and an
+optimizer then drifts anywhere along that set. ``proximal_weight`` (default
+:data:`PROXIMAL_WEIGHT`) adds ``w * mean((a - a_start)**2)`` over all activations, pulling
+toward the starting activations (the NMF of the MTP activations). It selects a solution
+where the settings' terms are flat and is negligible elsewhere; it is reported as its
+own entry (``proximal:start_activations``) and never counted in NCP's cost. Use 0 to drop it.
 """
 
 from __future__ import annotations
@@ -17,6 +25,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import attrs
+import casadi as cs
 import numpy as np
 
 from nmsm.constraints.ncp.synergy_weight_sum import SynergyWeightSum
@@ -27,6 +36,12 @@ from nmsm.tools.ncp.initial_guess import SynergyGuess
 from nmsm.tools.ncp.inputs import NcpInputs
 from nmsm.tools.ncp.solution import SynergySolution
 from nmsm.tools.ncp.synergies import activations as synergy_activations
+
+
+#: weight of the proximal term toward the starting activations (see module docstring)
+PROXIMAL_WEIGHT = 0.1
+#: name of the proximal cost entry
+PROXIMAL_ENTRY = "proximal:start_activations"
 
 
 def _safe(name: str) -> str:
@@ -67,8 +82,16 @@ class NcpProblem:
         )
 
 
-def build_problem(inputs: NcpInputs, terms: Sequence[Term], guess: SynergyGuess, *, name: str = "ncp") -> NcpProblem:
-    """Declare the variables, add ``terms`` and the weight-sum constraints (see module docstring)."""
+def build_problem(
+    inputs: NcpInputs,
+    terms: Sequence[Term],
+    guess: SynergyGuess,
+    *,
+    name: str = "ncp",
+    proximal_weight: float = PROXIMAL_WEIGHT,
+) -> NcpProblem:
+    """Declare the variables, add ``terms``, the weight-sum constraints and the proximal term
+    (see module docstring)."""
     layout = inputs.layout
     problem = OptimizationProblem(name)
     weight_names: list[str] = []
@@ -93,6 +116,14 @@ def build_problem(inputs: NcpInputs, terms: Sequence[Term], guess: SynergyGuess,
     context = NcpContext(inputs, weight_blocks, activations)
     for term in terms:
         problem.add_term(term, context)
+    if proximal_weight > 0:
+        start_weights = layout.weight_matrix(list(guess.weight_blocks))
+        deviations = []
+        for t, trial in enumerate(inputs.trials):
+            start = layout.commands(guess.nodes[t], trial.n_points) @ start_weights
+            deviations.append(cs.vec(activations[t] - cs.DM(start)))
+        stacked = cs.vertcat(*deviations)
+        problem.add_cost(PROXIMAL_ENTRY, stacked / np.sqrt(stacked.numel()), weight=proximal_weight)
     for group in layout.free_groups:
         g = layout.groups[group]
         problem.add_term(SynergyWeightSum(group=group, target=g.weight_sum, name=g.name), context)

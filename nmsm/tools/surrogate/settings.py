@@ -55,8 +55,8 @@ def surrogate_settings_from_document(doc: SettingsDocument) -> SurrogateSettings
     if model_holder is None:
         raise doc.error(tool, "required element <input_model_file> is missing", element="<input_model_file>",
                         expected="the model file")
-    model_file = doc.path(model_holder.getparent(), "input_model_file", required=True, kind="file")
-    data = doc.path(controller, "surrogate_model_data_directory", required=True, kind="dir")
+    model_file = doc.resolved_path(model_holder.getparent(), "input_model_file", required=True, kind="file")
+    data = doc.resolved_path(controller, "surrogate_model_data_directory", required=True, kind="dir")
     coords = tuple(doc.names(controller, "surrogate_model_coordinate_list", required=True))
     degree = doc.integer(controller, "surrogate_model_polynomial_degree", 5)
     if degree < 0:

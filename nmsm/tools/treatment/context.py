@@ -404,6 +404,8 @@ class _Quantities:
     def time_ratio(self) -> Any:
         """``T_ref / t_f``: derivative factor of signals following normalized time."""
         tf = self.trajectory.final_time
+        if self.data.free_final_time and not self.data.rescale_prescribed_derivatives:
+            return 1.0
         if not self.data.free_final_time:
             return self.data.reference_duration / float(self.data.final_time_guess)
         return self.data.reference_duration / tf

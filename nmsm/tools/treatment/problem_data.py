@@ -41,6 +41,10 @@ class TreatmentData:
     controllers: list[Any] = attrs.field(factory=list)
     parameters: dict[str, cs.MX] = attrs.field(factory=dict)
     acceleration_control_offset: int = 0
+    #: free final time: scale prescribed coordinates' speeds by T_ref/t_f and accelerations by
+    #: (T_ref/t_f)^2 (physically consistent time warping). False reproduces the original,
+    #: which warps their positions to the new duration but keeps the data's speeds.
+    rescale_prescribed_derivatives: bool = True
     _tracked_cache: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = attrs.field(factory=dict, repr=False)
 
     @property

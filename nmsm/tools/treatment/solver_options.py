@@ -1,7 +1,10 @@
 """The optimal control solver settings file, as nmsm applies it.
 
 Honoured: the mesh (``setup_mesh_phase_intervals`` x ``setup_mesh_phase_colpoints_per_Interval``
-LGR points), ``setup_nlp_max_iterations``, ``setup_nlp_tolerance`` (IPOPT ``tol``),
+LGR points), ``setup_nlp_max_iterations``, ``setup_nlp_tolerance`` (IPOPT ``tol`` on the objective
+normalized by its initial value - see ``TreatmentOptions.objective_scaling`` - capped at
+:data:`MAX_TOLERANCE` with a warning: the tutorials' value 1 lets IPOPT stop within a few
+iterations far from the optimum, e.g. 2.3 times the original's cost on TorqueTOSettingsV2),
 ``setup_nlp_linear_solver`` (HSL solvers fall back to MUMPS with a warning when HSL is not
 installed), ``setup_display_level`` (0: silent). Not applicable to nmsm, reported in one
 warning when they would change GPOPS-II's behaviour: the derivative options (nmsm's
@@ -23,6 +26,10 @@ import attrs
 from nmsm.tools.treatment.transcription.mesh import Mesh
 
 
+#: loosest IPOPT ``tol`` nmsm applies (on the normalized objective)
+MAX_TOLERANCE = 1e-2
+
+
 @attrs.frozen
 class SolverPlan:
     """Mesh and IPOPT options derived from the solver settings."""
@@ -37,9 +44,15 @@ def plan_from_settings(gpops: Any, *, source: str = "") -> SolverPlan:
     once about options that do not apply (see module docstring)."""
     mesh = Mesh.uniform(int(gpops.setup_mesh_phase_intervals), int(gpops.setup_mesh_phase_colpoints_per_Interval))
     display = int(gpops.setup_display_level)
+    where = f"{source}: " if source else ""
+    tol = float(gpops.setup_nlp_tolerance)
+    if tol > MAX_TOLERANCE:
+        warnings.warn(f"{where}setup_nlp_tolerance={tol:g} is looser than nmsm applies; IPOPT uses tol={MAX_TOLERANCE:g} "
+                      "on the objective normalized by its initial value (pass tolerance= to override)", stacklevel=2)
+        tol = MAX_TOLERANCE
     ipopt = {
         "max_iter": int(gpops.setup_nlp_max_iterations),
-        "tol": float(gpops.setup_nlp_tolerance),
+        "tol": tol,
         "linear_solver": str(gpops.setup_nlp_linear_solver),
         "print_level": 0 if display == 0 else (3 if display == 1 else 5),
     }
@@ -53,6 +66,5 @@ def plan_from_settings(gpops: Any, *, source: str = "") -> SolverPlan:
         ignored.append(f"setup_mesh_method={gpops.setup_mesh_method} (no mesh refinement: the initial mesh is used)")
     if gpops.setup_nlp_solver != "ipopt":
         ignored.append(f"setup_nlp_solver={gpops.setup_nlp_solver} (IPOPT is used)")
-    where = f"{source}: " if source else ""
     warnings.warn(where + "GPOPS-II options without effect in nmsm: " + "; ".join(ignored), stacklevel=2)
     return SolverPlan(mesh, ipopt, tuple(ignored))

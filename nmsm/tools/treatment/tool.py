@@ -44,7 +44,9 @@ class TreatmentOptions:
     ('initial': IPOPT minimizes the objective divided by its value at the initial guess,
     clipped to [1e-6, 1e6], so ``setup_nlp_tolerance`` acts on a relative scale; 'none';
     or a number: IPOPT's ``obj_scaling_factor``). ``parallel``: threads for
-    the per-point model functions. ``evaluate_only``: build, evaluate the cost at the
+    the per-point model functions. ``rescale_prescribed_derivatives``: with a free final time,
+    scale the prescribed coordinates' speeds and accelerations to the new duration (default;
+    False reproduces the original, which keeps the data's speeds). ``evaluate_only``: build, evaluate the cost at the
     starting point, do not solve.
     """
 
@@ -59,6 +61,7 @@ class TreatmentOptions:
     print_level: int | None = None
     ipopt_options: dict[str, Any] = attrs.field(factory=dict)
     objective_scaling: str | float = "initial"
+    rescale_prescribed_derivatives: bool = True
     parallel: int = 1
     evaluate_only: bool = False
     write_results: bool = True
@@ -235,7 +238,7 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     setup.extras["guess_files"] = guess_files
     controllers = _controllers(settings, tool, setup)
     data = TreatmentData(tool, model, states, refs, refs["coordinates"], t_ref, tf_guess, (lo_t, hi_t),
-                         controllers=controllers)
+                         controllers=controllers, rescale_prescribed_derivatives=options.rescale_prescribed_derivatives)
     state_setup = _state_setup(settings, files, guess_files, states, refs, plan, t_guess)
     problems = check_guess_within("state", tuple(states) + tuple(speed_label(c) for c in states),
                                   state_setup.guess, state_setup.lower, state_setup.upper)
