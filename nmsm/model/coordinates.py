@@ -17,6 +17,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.model.components import Model
+from nmsm.model.functions import value_and_derivatives
 
 
 class CoordinateMap:
@@ -55,16 +56,12 @@ class CoordinateMap:
         accelerations: list[Any] = [None] * n
         for k, i in enumerate(self.independent_indices):
             values[i], rates[i], accelerations[i] = q[k], qd[k], qdd[k]
-        x = cs.SX.sym("x")
         for name in self.dependent_names:
             coupler = self._couplers[name]
             i = self.names.index(name)
             j = self.names.index(coupler.independent[0])
-            f = coupler.scale_factor * coupler.function(x)
-            df = cs.gradient(f, x)
-            ddf = cs.gradient(df, x)
-            fun = cs.Function("coupler", [x], [f, df, ddf])
-            value, slope, curvature = fun(values[j])
+            value, slope, curvature = (coupler.scale_factor * v
+                                       for v in value_and_derivatives(coupler.function, values[j]))
             values[i] = value
             rates[i] = slope * rates[j]
             accelerations[i] = curvature * rates[j] ** 2 + slope * accelerations[j]

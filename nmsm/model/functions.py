@@ -82,11 +82,11 @@ class PolynomialFunction:
         return poly.deriv(order)(np.asarray(x, dtype=float)) if order else poly(np.asarray(x, dtype=float))
 
 
-@attrs.frozen
+@attrs.frozen(slots=False)
 class PiecewiseCubic:
     """A piecewise cubic on knots ``x`` with linear extrapolation outside ``[x[0], x[-1]]``.
 
-    On ``[x[i], x[i+1])``: ``y[i] + b[i] t + c[i] t^2 + d[i] t^3`` with ``t = x - x[i]``.
+    On ``[x[i], x[i+1]]``: ``y[i] + b[i] t + c[i] t^2 + d[i] t^3`` with ``t = x - x[i]``.
     Below ``x[0]``: ``y[0] + b[0] (x - x[0])``; above ``x[-1]``: ``y[-1] + b[-1] (x - x[-1])``.
     Base of :class:`SimmSpline`, :class:`NaturalCubicSpline` and :class:`PiecewiseLinearFunction`.
     """
@@ -96,6 +96,9 @@ class PiecewiseCubic:
     b: np.ndarray = attrs.field(eq=False)
     c: np.ndarray = attrs.field(eq=False)
     d: np.ndarray = attrs.field(eq=False)
+    #: piece used exactly at an interior knot ("right" or "left"; only derivatives of
+    #: order above the continuity differ); the end knots always belong to the end pieces
+    knot_side: str = "right"
 
     def _segments(self) -> tuple[np.ndarray, ...]:
         """Per-segment (base, y, b, c, d) including the two extrapolation segments."""
@@ -110,13 +113,81 @@ class PiecewiseCubic:
     def __call__(self, x: Any) -> Any:
         if len(self.x) == 1:
             return 0.0 * x + self.y[0]
+        if self._truncated_power_ok():
+            return self._truncated_power(x)
+        return self._selected_segment(x)
+
+    def _truncated_power(self, x: Any) -> Any:
+        """``s(x)`` as a cubic on the first piece plus third-derivative jumps
+        ``(d[k] - d[k-1]) max(x - x[k], 0)^3`` at the interior knots (the pieces of a C2 cubic
+        spline differ by exactly these terms), evaluated at ``x`` clamped to the knots, plus
+        linear extrapolation beyond them. Few operations, exact derivatives."""
+        lo, hi = float(self.x[0]), float(self.x[-1])
+        inner = _fmin(_fmax(x, lo), hi)
+        t = inner - lo
+        value = self.y[0] + t * (self.b[0] + t * (self.c[0] + t * self.d[0]))
+        for k in range(1, len(self.x) - 1):
+            jump = float(self.d[k] - self.d[k - 1])
+            if jump != 0.0:
+                r = _fmax(inner - float(self.x[k]), 0.0)
+                value = value + jump * (r * r * r)
+        below = x - _fmax(x, lo)  # <= 0 below the knots, else 0
+        above = x - _fmin(x, hi)  # >= 0 above the knots, else 0
+        return value + float(self.b[0]) * below + float(self.b[-1]) * above
+
+    def value_and_derivatives(self, x: Any) -> tuple[Any, Any, Any]:
+        """``(s, s', s'')`` at ``x`` in closed form (same forms as ``__call__``)."""
+        if len(self.x) == 1 or not self._truncated_power_ok():
+            return _derivatives_by_ad(self, x)
+        lo, hi = float(self.x[0]), float(self.x[-1])
+        inner = _fmin(_fmax(x, lo), hi)
+        t = inner - lo
+        d1 = self.b[0] + t * (2.0 * self.c[0] + 3.0 * self.d[0] * t)
+        d2 = 2.0 * self.c[0] + 6.0 * self.d[0] * t
+        for k in range(1, len(self.x) - 1):
+            jump = float(self.d[k] - self.d[k - 1])
+            if jump != 0.0:
+                r = _fmax(inner - float(self.x[k]), 0.0)
+                d1 = d1 + 3.0 * jump * (r * r)
+                d2 = d2 + 6.0 * jump * r
+        inside = (x >= lo) * (x <= hi)
+        return self(x), d1, d2 * inside
+
+    def _truncated_power_ok(self) -> bool:
+        """Whether the truncated-power form reproduces the piecewise form to 1e-13 (relative
+        to the largest value) at the knots, midpoints and beyond the ends."""
+        cached = getattr(self, "_tp_ok", None)
+        if cached is not None:
+            return cached
+        if len(self.x) < 3:
+            ok = False
+        else:
+            mids = 0.5 * (self.x[1:] + self.x[:-1])
+            span = self.x[-1] - self.x[0]
+            probe = np.concatenate([self.x, mids, [self.x[0] - 0.3 * span, self.x[-1] + 0.3 * span]])
+            reference = self.numeric(probe)
+            ours = np.array([float(self._truncated_power(v)) for v in probe])
+            scale = max(1.0, float(np.abs(reference).max()))
+            ok = bool(np.abs(ours - reference).max() <= 1e-13 * scale)
+        object.__setattr__(self, "_tp_ok", ok)
+        return ok
+
+    def _selected_segment(self, x: Any) -> Any:
+        """``s(x)`` with the piece chosen by exact 0/1 interval indicators (any knot count)."""
         base, y, b, c, d = self._segments()
         # indicator of each segment: exactly one is 1, the others exactly 0
-        edges = list(self.x)
-        indicators = [1.0 - (x >= edges[0])]
+        edges = [float(v) for v in self.x]
+        last = len(edges) - 2
+        indicators = [x < edges[0]]
         for k in range(len(edges) - 1):
-            indicators.append((x >= edges[k]) * (1.0 - (x >= edges[k + 1])))
-        indicators.append(x >= edges[-1])
+            if self.knot_side == "right":
+                lower = x >= edges[k]
+                upper = (x <= edges[k + 1]) if k == last else (x < edges[k + 1])
+            else:
+                lower = (x >= edges[k]) if k == 0 else (x > edges[k])
+                upper = x <= edges[k + 1]
+            indicators.append(lower * upper)
+        indicators.append(x > edges[-1])
 
         def pick(values: np.ndarray) -> Any:
             total = 0.0 * x
@@ -133,7 +204,9 @@ class PiecewiseCubic:
         if len(self.x) == 1:
             return np.full(x.shape, self.y[0] if order == 0 else 0.0)
         base, y, b, c, d = self._segments()
-        k = np.searchsorted(self.x, x, side="right")  # 0: below, n: at/above last knot
+        n = len(self.x)
+        k = np.searchsorted(self.x, x, side=self.knot_side)  # segment: 0 below, n above
+        k = np.where(x == self.x[-1], n - 1, np.where(x == self.x[0], 1, k))
         t = x - base[k]
         if order == 0:
             return y[k] + t * (b[k] + t * (c[k] + t * d[k]))
@@ -144,6 +217,49 @@ class PiecewiseCubic:
         if order == 3:
             return 6 * d[k]
         return np.zeros(x.shape)
+
+
+def _derivatives_by_ad(function: Any, x: Any) -> tuple[Any, Any, Any]:
+    import casadi as cs
+
+    if not isinstance(x, (cs.SX, cs.MX)):
+        return (function(x), function.numeric(x, 1), function.numeric(x, 2))
+    s = cs.SX.sym("s")
+    value = function(s)
+    d1 = cs.gradient(value, s)
+    d2 = cs.gradient(d1, s)
+    return cs.Function("f", [s], [value, d1, d2])(x)
+
+
+def value_and_derivatives(function: Any, x: Any) -> tuple[Any, Any, Any]:
+    """``(f, f', f'')`` of any supported function at ``x`` (float, numpy or CasADi),
+    in closed form for splines (cheaper derivative graphs than automatic differentiation)."""
+    if isinstance(function, PiecewiseCubic):
+        return function.value_and_derivatives(x)
+    if isinstance(function, MultiplierFunction):
+        v, d1, d2 = value_and_derivatives(function.function, x)
+        return function.scale * v, function.scale * d1, function.scale * d2
+    if isinstance(function, LinearFunction):
+        return function(x), function.slope + 0.0 * x, 0.0 * x
+    if isinstance(function, Constant):
+        return function(x), 0.0 * x, 0.0 * x
+    return _derivatives_by_ad(function, x)
+
+
+def _fmax(a: Any, b: float) -> Any:
+    if isinstance(a, (float, int, np.floating, np.ndarray)):
+        return np.maximum(a, b)
+    import casadi as cs
+
+    return cs.fmax(a, b)
+
+
+def _fmin(a: Any, b: float) -> Any:
+    if isinstance(a, (float, int, np.floating, np.ndarray)):
+        return np.minimum(a, b)
+    import casadi as cs
+
+    return cs.fmin(a, b)
 
 
 def _check_knots(x: np.ndarray, y: np.ndarray, what: str, file: Any, element: str | None) -> None:

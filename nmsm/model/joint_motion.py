@@ -26,7 +26,7 @@ import numpy as np
 
 from nmsm.errors import ModelError
 from nmsm.model.components import Joint
-from nmsm.model.functions import LinearFunction
+from nmsm.model.functions import LinearFunction, value_and_derivatives
 from nmsm.model.spatial import axis_angle, body_xyz, vee
 
 _X = np.array([1.0, 0.0, 0.0])
@@ -37,24 +37,42 @@ _Z = np.array([0.0, 0.0, 1.0])
 ANGULAR_VELOCITY_JOINTS = ("FreeJoint", "BallJoint")
 
 
-def _custom_pose(joint: Joint, q: cs.SX, s: cs.SX, coordinate_index: dict[str, int]) -> tuple[cs.SX, cs.SX]:
+def _is_coordinate_axis(axis) -> bool:
+    f = axis.function
+    return isinstance(f, LinearFunction) and f.slope == 1.0 and f.intercept == 0.0
+
+
+def _axis_values(joint: Joint, q: cs.SX, u: cs.SX | None, s: cs.SX) -> tuple[list, cs.SX, cs.SX]:
+    """Values of a CustomJoint's six axes (translations other than pure coordinate axes
+    scaled by ``s``), ``d value/dq`` ``(6, k)`` and ``f'' u_c^2`` ``(6, 1)``."""
+    k = len(joint.coordinates)
+    index = {name: i for i, name in enumerate(joint.coordinates)}
+    fq = cs.SX.zeros(6, k)
+    second = cs.SX.zeros(6, 1)
+    values = []
+    for i, axis in enumerate(joint.transform_axes):
+        factor = s if i >= 3 and not _is_coordinate_axis(axis) else 1.0
+        if axis.coordinates:
+            c = index[axis.coordinates[0]]
+            val, der, der2 = value_and_derivatives(axis.function, q[c])
+            fq[i, c] = der * factor
+            if u is not None:
+                second[i] = der2 * factor * u[c] ** 2
+        else:
+            val = axis.function(0.0)
+        values.append(val * factor)
+    return values, fq, second
+
+
+def _custom_pose(joint: Joint, values: list) -> tuple[cs.SX, cs.SX]:
     rotation = cs.SX.eye(3)
     translation = cs.SX.zeros(3, 1)
     for index, axis in enumerate(joint.transform_axes):
-        if axis.coordinates:
-            value = axis.function(q[coordinate_index[axis.coordinates[0]]])
-        else:
-            value = axis.function(0.0)
+        direction = np.asarray(axis.axis, dtype=float)
         if index < 3:
-            rotation = cs.mtimes(rotation, axis_angle(axis.axis, value))
+            rotation = cs.mtimes(rotation, axis_angle(direction, values[index]))
         else:
-            direction = np.asarray(axis.axis, dtype=float)
-            unit = direction / np.linalg.norm(direction)
-            f = axis.function
-            is_dof = isinstance(f, LinearFunction) and f.slope == 1.0 and f.intercept == 0.0
-            if not is_dof:
-                value = value * s
-            translation = translation + value * cs.DM(unit)
+            translation = translation + values[index] * cs.DM(direction / np.linalg.norm(direction))
     return rotation, translation
 
 
@@ -63,7 +81,7 @@ def joint_pose(joint: Joint, q: cs.SX, s: cs.SX) -> tuple[cs.SX, cs.SX]:
     t = joint.type
     zero = cs.SX.zeros(3, 1)
     if t == "CustomJoint":
-        return _custom_pose(joint, q, s, {name: i for i, name in enumerate(joint.coordinates)})
+        return _custom_pose(joint, _axis_values(joint, q, None, s)[0])
     if t == "WeldJoint":
         return cs.SX.eye(3), zero
     if t == "PinJoint":
@@ -81,39 +99,16 @@ def joint_pose(joint: Joint, q: cs.SX, s: cs.SX) -> tuple[cs.SX, cs.SX]:
     raise ModelError(f"joint type '{t}' is not supported", element=f"{t} '{joint.name}'")
 
 
-def _custom_simbody_motion(joint: Joint, q: cs.SX, u: cs.SX, s: cs.SX) -> tuple[cs.SX, ...]:
+def _custom_simbody_motion(joint: Joint, values: list, fq: cs.SX, second: cs.SX, u: cs.SX) -> tuple[cs.SX, ...]:
     """``(H_w, H_v, c_w, c_v)`` of a CustomJoint as Simbody's FunctionBased mobilizer
     computes them: the angular velocity is exact (``w = W theta_dot`` with
     ``W = [a1, R1 a2, R1 R2 a3]``), but the rate of ``W`` uses the angular velocities of
     the first mobility alone and of all mobilities except the third, which is exact only
     when mobility i drives rotation axis i."""
-    k = len(joint.coordinates)
-    index = {name: i for i, name in enumerate(joint.coordinates)}
-    fq = cs.SX.zeros(6, k)  # d(axis value)/dq
-    second = cs.SX.zeros(6, 1)  # f'' u_c^2 per axis
-    angles = []
-    x = cs.SX.sym("x")
-    for i, axis in enumerate(joint.transform_axes):
-        factor = 1.0
-        if i >= 3:
-            f = axis.function
-            is_dof = isinstance(f, LinearFunction) and f.slope == 1.0 and f.intercept == 0.0
-            factor = 1.0 if is_dof else s
-        if axis.coordinates:
-            c = index[axis.coordinates[0]]
-            value = axis.function(x)
-            d1 = cs.gradient(value, x)
-            d2 = cs.gradient(d1, x)
-            fun = cs.Function("axis", [x], [value, d1, d2])
-            val, der, der2 = fun(q[c])
-            fq[i, c] = der * factor
-            second[i] = der2 * factor * u[c] ** 2
-        else:
-            val = axis.function(0.0)
-        angles.append(val)
+    k = fq.shape[1]
     units = [np.asarray(a.axis, dtype=float) / np.linalg.norm(a.axis) for a in joint.transform_axes]
-    r1 = axis_angle(units[0], angles[0])
-    r2 = cs.mtimes(r1, axis_angle(units[1], angles[1]))
+    r1 = axis_angle(units[0], values[0])
+    r2 = cs.mtimes(r1, axis_angle(units[1], values[1]))
     w_cols = [cs.DM(units[0]), cs.mtimes(r1, cs.DM(units[1])), cs.mtimes(r2, cs.DM(units[2]))]
     w_mat = cs.horzcat(*w_cols)
     a_trans = cs.horzcat(*[cs.DM(units[i]) for i in (3, 4, 5)])
@@ -177,7 +172,11 @@ def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> c
     q = cs.SX.sym("q", k)
     u = cs.SX.sym("u", k)
     s = cs.SX.sym("s")
-    rotation, translation = joint_pose(joint, q, s)
+    if joint.type == "CustomJoint":
+        values, fq, second = _axis_values(joint, q, u, s)
+        rotation, translation = _custom_pose(joint, values)
+    else:
+        rotation, translation = joint_pose(joint, q, s)
     if joint.type in ANGULAR_VELOCITY_JOINTS:
         h_w = cs.SX.zeros(3, k)
         h_w[:, 0:3] = cs.SX.eye(3)
@@ -187,7 +186,7 @@ def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> c
             h_v[:, 3:6] = cs.SX.eye(3)
         c_v = cs.SX.zeros(3, 1)
     elif k and joint.type == "CustomJoint" and custom_joint_bias == "opensim":
-        h_w, h_v, c_w, c_v = _custom_simbody_motion(joint, q, u, s)
+        h_w, h_v, c_w, c_v = _custom_simbody_motion(joint, values, fq, second, u)
     elif joint.type in _FIXED_AXIS_JOINTS:
         h_w, h_v, c_w, c_v = _fixed_axis_motion(joint.type, q, u)
     elif k:
@@ -205,5 +204,5 @@ def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> c
         c_v = cs.SX.zeros(3, 1)
     return cs.Function(
         f"motion_{joint.name}", [q, u, s], [rotation, translation, h_w, h_v, c_w, c_v],
-        ["q", "u", "s"], ["R", "p", "H_w", "H_v", "c_w", "c_v"],
+        ["q", "u", "s"], ["R", "p", "H_w", "H_v", "c_w", "c_v"], {"cse": True},
     )

@@ -11,7 +11,8 @@ coordinates of couplers from their coupler (what OpenSim's ``Model.assemble`` do
 Coordinate speeds: derivative of an interpolating quintic spline with natural end
 conditions (third and fourth derivatives zero at the ends) through each independent
 coordinate, the spline OpenSim's AnalyzeTool differentiates (GCV spline, error variance
-0); fewer than 6 frames use ``numpy.gradient``.
+0); fewer than 6 frames use ``numpy.gradient``. Optional low-pass filtering of the
+coordinates first, as AnalyzeTool's ``lowpass_cutoff_frequency_for_coordinates``.
 
 Quantities (SI): length L (m); velocity ``V = Σ_c dL/dq_c q̇_c`` (m/s) over independent
 coordinates, total derivatives through couplers; moment arm ``r_c = −dL/dq_c`` (m). For a
@@ -135,6 +136,16 @@ def coordinate_speeds(time: np.ndarray, q: np.ndarray) -> np.ndarray:
     return quintic_spline(time, q, time)[1]
 
 
+def _filtered(time: np.ndarray, q: np.ndarray, lowpass_hz: float, table: Table) -> tuple[np.ndarray, np.ndarray]:
+    """Padded, low-passed and splined coordinates and their speeds at ``time`` (AnalyzeTool's filtering)."""
+    from nmsm.model.signal import lowpass_iir, pad, quintic_spline, uniform_interval
+
+    n_pad = len(time) // 2
+    values = lowpass_iir(pad(q, n_pad), uniform_interval(time, source=table.source), lowpass_hz)
+    q_filtered, qdot, _ = quintic_spline(pad(time, n_pad), values, time)
+    return q_filtered, qdot
+
+
 # ---- engines ------------------------------------------------------------------------------
 def _opensim_geometry(model_file: Path, model: Any, q: np.ndarray, muscles: Sequence[str], independent: Sequence[str],
                       bridge: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -175,13 +186,16 @@ def analyze_motion(
     surrogate: Any | None = None,
     bridge: Any | None = None,
     model: Any | None = None,
+    lowpass_hz: float | None = None,
 ) -> MuscleAnalysisResult:
     """Lengths, velocities and moment arms of ``muscles`` along ``motion``.
 
     ``coordinates``: moment-arm coordinates (default: every model coordinate, as
     MuscleAnalysis with ``all``). ``surrogate``: a
     :class:`~nmsm.model.surrogate.SurrogateModel` for wrapping muscles. ``model``: the
-    parsed model, when the caller has it.
+    parsed model, when the caller has it. ``lowpass_hz``: low-pass the coordinates first
+    as OpenSim's AnalyzeTool does (``lowpass_cutoff_frequency_for_coordinates``: pad by
+    half the rows, third-order Butterworth forward and backward; :mod:`nmsm.model.signal`).
     """
     if engine not in ENGINES:
         raise InputError(f"unknown engine '{engine}'", element="engine", expected=" or ".join(ENGINES))
@@ -201,7 +215,15 @@ def analyze_motion(
     independent = [n for n in names if n not in dependents]
 
     q = motion_poses(model, table)
-    qdot = coordinate_speeds(table.time, q[:, [names.index(c) for c in independent]])
+    columns = [names.index(c) for c in independent]
+    if lowpass_hz is not None and lowpass_hz > 0:
+        q[:, columns], qdot = _filtered(table.time, q[:, columns], lowpass_hz, table)
+        if dependents:
+            from nmsm.model.coordinates import CoordinateMap
+
+            q = CoordinateMap(model).dependent_values(q)
+    else:
+        qdot = coordinate_speeds(table.time, q[:, columns])
 
     from nmsm.model.muscle_paths import has_active_wrapping
 

@@ -167,7 +167,8 @@ class OsimWriter:
         """Apply a uniform scale ``factor`` to ``body`` as nmsm's kinematics do (see
         :mod:`nmsm.model.parameters`): offset frames attached to it, markers, path points,
         wrap objects and contact geometry on it, translation functions of CustomJoints whose
-        parent frame is on it, its centre of mass and inertia (and mass with ``scale_mass``).
+        parent frame is on it, its centre of mass and inertia (and mass with ``scale_mass``),
+        the ``scale_factors`` of its attached geometry (display meshes, as ``Model.scale``).
         Muscle optimal fibre and tendon slack lengths are not changed (set them with
         :meth:`set_muscle_property`)."""
         from nmsm.model.osim import load_model
@@ -229,6 +230,10 @@ class OsimWriter:
             self._set(elem, "inertia", format_vector(inertia * factor**5))
         else:
             self._set(elem, "inertia", format_vector(inertia * factor**2))
+        attached = elem.find("attached_geometry")
+        for geometry in attached if attached is not None else ():
+            if isinstance(geometry.tag, str) and geometry.find("scale_factors") is not None:
+                self._set(geometry, "scale_factors", format_vector(self.current(geometry, "scale_factors") * factor))
 
     def _scale_function(self, func: etree._Element | None, factor: float) -> None:
         """Multiply a function's values by ``factor`` (exact for every supported type)."""

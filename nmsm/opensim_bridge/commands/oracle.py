@@ -19,6 +19,7 @@ import opensim as osim
 from nmsm.opensim_bridge.commands import command
 
 _MODELS: dict[tuple[str, float, str], Any] = {}
+_KEEP: list[Any] = []
 
 
 def _vec3(v: Any) -> list[float]:
@@ -158,6 +159,26 @@ def oracle_model_summary(path: str) -> dict[str, Any]:
         members = group.getMembers()
         groups[group.getName()] = [members.get(k).getName() for k in range(members.getSize())]
     summary["groups"] = groups
+    wraps = {}
+    for i in range(bodies.getSize()):
+        body = bodies.get(i)
+        wrap_set = body.getWrapObjectSet()
+        for k in range(wrap_set.getSize()):
+            w = wrap_set.get(k)
+            entry = {"type": w.getConcreteClassName(), "body": body.getName(), "active": bool(w.get_active()),
+                     "translation": _vec3(w.get_translation()), "rotation": _vec3(w.get_xyz_body_rotation()),
+                     "quadrant": w.get_quadrant()}
+            for cls, props in (("WrapCylinder", ("radius", "length")), ("WrapSphere", ("radius",)),
+                               ("WrapTorus", ("inner_radius", "outer_radius"))):
+                typed = getattr(osim, cls).safeDownCast(w)
+                if typed is not None:
+                    for prop in props:
+                        entry[prop] = getattr(typed, f"get_{prop}")()
+            ellipsoid = osim.WrapEllipsoid.safeDownCast(w)
+            if ellipsoid is not None:
+                entry["dimensions"] = _vec3(ellipsoid.get_dimensions())
+            wraps[w.getName()] = entry
+    summary["wrap_objects"] = wraps
     del state
     return summary
 
@@ -270,7 +291,11 @@ def _function(spec: dict[str, Any]) -> Any:
             coefficients.set(i, float(c))
         return osim.PolynomialFunction(coefficients)
     if kind == "MultiplierFunction":
-        return osim.MultiplierFunction(_function(spec["function"]), float(spec["scale"]))
+        inner = _function(spec["function"])
+        _KEEP.append(inner)  # OpenSim may take ownership: never let Python free it
+        outer = osim.MultiplierFunction(inner, float(spec["scale"]))
+        inner.thisown = False
+        return outer
     if kind not in ("SimmSpline", "NaturalCubicSpline", "PiecewiseLinearFunction"):
         raise ValueError(f"unknown function type {kind}")
     if not hasattr(osim, kind):

@@ -1,9 +1,9 @@
 """Bound-constrained Levenberg-Marquardt for nonlinear least squares ``min sum(r(x)**2)``.
 
 Used by inverse kinematics (one small dense problem per frame) and by Joint Model
-Personalization (all frames' coordinates and the model parameters in one large sparse
-problem). The Jacobian is exact (CasADi), so each iteration is a Gauss-Newton step
-regularized by Marquardt's scaled damping ``mu * diag(J^T J)``:
+Personalization (all frames' coordinates and the model parameters together). The
+Jacobian is exact (CasADi), so each iteration is a Gauss-Newton step regularized by
+Marquardt's scaled damping ``mu * diag(J^T J)``:
 
     (J_f^T J_f + mu D_f) s_f = -J_f^T r
 
@@ -19,24 +19,158 @@ Convergence (any of):
 * ``|projected gradient|_inf <= gtol``                               (first order)
 * ``cost <= ctol``                                                   (exact fit)
 
-``solve_dense`` takes numpy Jacobians; ``solve_sparse`` takes scipy sparse ones and
-factorizes the damped normal matrix with SuperLU (fill-reducing column ordering), which
-handles the block-arrow structure of JMP (per-frame coordinate blocks plus a few dense
-parameter columns) in time linear in the number of frames.
+The linear algebra is pluggable: ``fun(x)`` returns ``(r, J)`` with ``J`` one of
+
+* :class:`DenseJacobian` (numpy, small problems: IK frames);
+* :class:`SparseJacobian` (scipy sparse; SuperLU on the damped normal matrix);
+* :class:`BlockArrowJacobian` (JMP: per-frame blocks ``dr_f/dq_f`` and ``dr_f/dp`` with
+  ``x = [q_1, ..., q_F, p]``), solved by the Schur complement on the shared parameters in
+  time linear in the number of frames.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Protocol
 
 import attrs
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
-#: ``x -> (r (m,), J (m, n))``
-ResidualJacobian = Callable[[np.ndarray], tuple[np.ndarray, Any]]
+
+class Jacobian(Protocol):
+    """What the algorithm needs from a Jacobian ``J`` (m x n)."""
+
+    def gradient(self, r: np.ndarray) -> np.ndarray:
+        """``J^T r`` (n,)."""
+
+    def normal_diagonal(self) -> np.ndarray:
+        """``diag(J^T J)`` (n,)."""
+
+    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
+        """``s`` with ``(J^T J + mu diag(diag))_ff s_f = -g_f`` and ``s = 0`` off ``free``."""
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        """``|J s|^2``."""
+
+
+@attrs.frozen
+class DenseJacobian:
+    """A numpy Jacobian ``(m, n)``."""
+
+    matrix: np.ndarray
+
+    def gradient(self, r: np.ndarray) -> np.ndarray:
+        return self.matrix.T @ r
+
+    def normal_diagonal(self) -> np.ndarray:
+        return np.einsum("ij,ij->j", self.matrix, self.matrix)
+
+    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
+        idx = np.flatnonzero(free)
+        step = np.zeros_like(g)
+        if idx.size == 0:
+            return step
+        j = self.matrix[:, idx]
+        a = j.T @ j
+        a[np.diag_indices_from(a)] += mu * diag[idx]
+        try:
+            step[idx] = -np.linalg.solve(a, g[idx])
+        except np.linalg.LinAlgError:
+            step[idx] = -np.linalg.lstsq(a, g[idx], rcond=None)[0]
+        return step
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        v = self.matrix @ s
+        return float(v @ v)
+
+
+@attrs.frozen
+class SparseJacobian:
+    """A scipy sparse Jacobian ``(m, n)``."""
+
+    matrix: scipy.sparse.csc_matrix
+
+    def gradient(self, r: np.ndarray) -> np.ndarray:
+        return np.asarray(self.matrix.T @ r).ravel()
+
+    def normal_diagonal(self) -> np.ndarray:
+        return np.asarray(self.matrix.multiply(self.matrix).sum(axis=0)).ravel()
+
+    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
+        idx = np.flatnonzero(free)
+        step = np.zeros_like(g)
+        if idx.size == 0:
+            return step
+        j = self.matrix[:, idx]
+        a = (j.T @ j).tocsc() + scipy.sparse.diags(mu * diag[idx], format="csc")
+        step[idx] = -scipy.sparse.linalg.splu(a, permc_spec="COLAMD").solve(g[idx])
+        return step
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        v = self.matrix @ s
+        return float(v @ v)
+
+
+@attrs.frozen
+class BlockArrowJacobian:
+    """Jacobian of residuals ``r = [r_1; ...; r_F]`` (``r_f``: m each) in ``x = [q_1 .. q_F, p]``
+    where ``r_f`` depends on ``q_f`` (n each) and ``p`` (k) only.
+
+    ``dq`` ``(F, m, n)`` = dr_f/dq_f; ``dp`` ``(F, m, k)`` = dr_f/dp.
+    """
+
+    dq: np.ndarray
+    dp: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int, int, int]:
+        f, m, n = self.dq.shape
+        return f, m, n, self.dp.shape[2]
+
+    def gradient(self, r: np.ndarray) -> np.ndarray:
+        f, m, n, k = self.shape
+        rr = r.reshape(f, m)
+        return np.concatenate([np.einsum("fmn,fm->fn", self.dq, rr).ravel(), np.einsum("fmk,fm->k", self.dp, rr)])
+
+    def normal_diagonal(self) -> np.ndarray:
+        return np.concatenate([np.einsum("fmn,fmn->fn", self.dq, self.dq).ravel(),
+                               np.einsum("fmk,fmk->k", self.dp, self.dp)])
+
+    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
+        f, m, n, k = self.shape
+        free_q = free[: f * n].reshape(f, n).astype(float)
+        free_p = free[f * n:].astype(float)
+        dq = self.dq * free_q[:, None, :]
+        dp = self.dp * free_p[None, None, :]
+        dq_t = dq.transpose(0, 2, 1)
+        a = dq_t @ dq
+        b = dq_t @ dp
+        c = np.tensordot(dp, dp, axes=([0, 1], [0, 1]))
+        dq_diag = (mu * diag[: f * n].reshape(f, n)) * free_q + (1.0 - free_q)
+        a[:, np.arange(n), np.arange(n)] += dq_diag
+        c[np.arange(k), np.arange(k)] += mu * diag[f * n:] * free_p + (1.0 - free_p)
+        gq = g[: f * n].reshape(f, n) * free_q
+        gp = g[f * n:] * free_p
+        if k == 0:
+            return -np.linalg.solve(a, gq[:, :, None])[:, :, 0].ravel()
+        solved = np.linalg.solve(a, np.concatenate([b, gq[:, :, None]], axis=2))
+        x_b, y = solved[:, :, :k], solved[:, :, k]
+        schur = c - np.tensordot(b, x_b, axes=([0, 1], [0, 1]))
+        rhs = -gp + np.tensordot(b, y, axes=([0, 1], [0, 1]))
+        step_p = np.linalg.solve(schur, rhs)
+        step_q = -(y + x_b @ step_p)
+        return np.concatenate([step_q.ravel(), step_p]) * free
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        f, m, n, k = self.shape
+        v = np.einsum("fmn,fn->fm", self.dq, s[: f * n].reshape(f, n)) + np.einsum("fmk,k->fm", self.dp, s[f * n:])
+        return float(np.sum(v * v))
+
+
+#: ``x -> (r (m,), J)``
+ResidualJacobian = Callable[[np.ndarray], tuple[np.ndarray, Jacobian]]
 
 
 @attrs.frozen
@@ -65,56 +199,34 @@ class Tolerances:
     max_evaluations: int = 1000
 
 
-def _dense_step(jtj: np.ndarray, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
-    idx = np.flatnonzero(free)
-    step = np.zeros_like(g)
-    if idx.size == 0:
-        return step
-    a = jtj[np.ix_(idx, idx)].copy()
-    a[np.diag_indices_from(a)] += mu * diag[idx]
-    try:
-        step[idx] = -np.linalg.solve(a, g[idx])
-    except np.linalg.LinAlgError:
-        step[idx] = -np.linalg.lstsq(a, g[idx], rcond=None)[0]
-    return step
+def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: Any = np.inf,
+          tolerances: Tolerances = Tolerances(),
+          callback: Callable[[int, float, np.ndarray], None] | None = None) -> LeastSquaresResult:
+    """Minimize ``sum(r(x)**2)`` subject to ``lower <= x <= upper`` (see module docstring).
 
-
-def _sparse_step(jtj: scipy.sparse.csc_matrix, g: np.ndarray, free: np.ndarray, mu: float,
-                 diag: np.ndarray) -> np.ndarray:
-    idx = np.flatnonzero(free)
-    step = np.zeros_like(g)
-    if idx.size == 0:
-        return step
-    a = jtj[idx][:, idx] + scipy.sparse.diags(mu * diag[idx])
-    lu = scipy.sparse.linalg.splu(scipy.sparse.csc_matrix(a), permc_spec="COLAMD")
-    step[idx] = -lu.solve(g[idx])
-    return step
-
-
-def _solve(fun: ResidualJacobian, x0: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-           tol: Tolerances, sparse: bool, callback: Callable[[int, float, np.ndarray], None] | None) -> LeastSquaresResult:
+    ``callback(iteration, cost, x)`` is called after every iteration.
+    """
+    tol = tolerances
+    x0 = np.asarray(x0, dtype=float)
     lower = np.broadcast_to(np.asarray(lower, dtype=float), x0.shape)
     upper = np.broadcast_to(np.asarray(upper, dtype=float), x0.shape)
     if np.any(lower > upper):
         raise ValueError("a lower bound is above its upper bound")
-    x = np.clip(np.asarray(x0, dtype=float), lower, upper)
+    x = np.clip(x0, lower, upper)
     r, jac = fun(x)
     evaluations = 1
     cost = float(r @ r)
-    mu: float | None = None
+    mu = 1e-3
     nu = 2.0
     status = "maximum iterations reached"
     converged = False
     pg_norm = np.inf
     iteration = 0
+    fixed = lower == upper
     for iteration in range(1, tol.max_iterations + 1):
-        g = np.asarray(jac.T @ r).ravel()
-        jtj = (jac.T @ jac).tocsc() if sparse else jac.T @ jac
+        g = jac.gradient(r)
         span = np.maximum(1e-12, 1e-12 * np.abs(x))
-        at_lower = x <= lower + span
-        at_upper = x >= upper - span
-        fixed = lower == upper
-        active = fixed | (at_lower & (g > 0)) | (at_upper & (g < 0))
+        active = fixed | ((x <= lower + span) & (g > 0)) | ((x >= upper - span) & (g < 0))
         free = ~active
         pg_norm = float(np.max(np.abs(g[free]), initial=0.0))
         if cost <= tol.ctol:
@@ -123,21 +235,17 @@ def _solve(fun: ResidualJacobian, x0: np.ndarray, lower: np.ndarray, upper: np.n
         if pg_norm <= tol.gtol:
             status, converged = "projected gradient below gtol", True
             break
-        diag = np.asarray(jtj.diagonal()).ravel().copy()
-        dmax = float(np.max(diag[free], initial=0.0))
-        diag = np.maximum(diag, max(dmax, 1e-300) * 1e-10)
-        if mu is None:
-            mu = 1e-3
-        accepted = False
-        exhausted = False
+        diag = jac.normal_diagonal()
+        diag = np.maximum(diag, max(float(np.max(diag[free], initial=0.0)), 1e-300) * 1e-10)
+        accepted = exhausted = False
         while True:
-            step = (_sparse_step if sparse else _dense_step)(jtj, g, free, mu, diag)
+            step = jac.damped_step(g, free, mu, diag)
             trial = np.clip(x + step, lower, upper)
             step = trial - x
             if float(np.max(np.abs(step), initial=0.0)) <= tol.xtol * (tol.xtol + float(np.max(np.abs(x), initial=0.0))):
                 status, converged = "step below xtol", True
                 break
-            predicted = -(2.0 * float(g @ step) + float(step @ (jtj @ step)))
+            predicted = -(2.0 * float(g @ step) + jac.squared_norm_of_product(step))
             r_new, jac_new = fun(trial)
             evaluations += 1
             cost_new = float(r_new @ r_new)
@@ -160,7 +268,7 @@ def _solve(fun: ResidualJacobian, x0: np.ndarray, lower: np.ndarray, upper: np.n
             if mu > 1e20:
                 status, converged = "no decrease possible (machine precision)", True
                 break
-        if callback is not None:
+        if callback is not None and accepted:
             callback(iteration, cost, x)
         if converged:
             break
@@ -169,17 +277,3 @@ def _solve(fun: ResidualJacobian, x0: np.ndarray, lower: np.ndarray, upper: np.n
             break
     return LeastSquaresResult(x=x, residuals=r, cost=cost, iterations=iteration, evaluations=evaluations,
                               converged=converged, status=status, gradient_norm=pg_norm)
-
-
-def solve_dense(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: Any = np.inf,
-                tolerances: Tolerances = Tolerances(),
-                callback: Callable[[int, float, np.ndarray], None] | None = None) -> LeastSquaresResult:
-    """Minimize ``sum(r(x)**2)`` subject to ``lower <= x <= upper``; ``fun`` returns dense ``J``."""
-    return _solve(fun, np.asarray(x0, dtype=float), lower, upper, tolerances, False, callback)
-
-
-def solve_sparse(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: Any = np.inf,
-                 tolerances: Tolerances = Tolerances(),
-                 callback: Callable[[int, float, np.ndarray], None] | None = None) -> LeastSquaresResult:
-    """As :func:`solve_dense` with ``J`` a scipy sparse matrix (for thousands of variables)."""
-    return _solve(fun, np.asarray(x0, dtype=float), lower, upper, tolerances, True, callback)

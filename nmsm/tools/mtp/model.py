@@ -10,8 +10,12 @@ Chain per trial and muscle (tools.md §4.2, Meyer 2017):
 4. normalized fiber length/velocity with scaled ``l_o``, ``l_ts``; tendon force and passive
    force (:mod:`nmsm.model.hill`).
 
-One SX function per trial evaluates the chain for one muscle and is ``map``-ped over the
-muscles; the joint moments are MX sums. Design quantities enter in their MTP units:
+Two SX functions per trial evaluate the chain for one muscle and are ``map``-ped over the
+muscles: excitation -> activation (depends on the activation parameters and, with SynX,
+synergy weights) and activation -> forces (depends on the length scale factors); the
+joint moments are MX sums. Keeping the two apart lets a problem *lift* the activations
+(decision variables constrained to the modeled ones), which keeps exact Jacobians and
+Hessians sparse. Design quantities enter in their MTP units:
 electromechanical delay in 0.1 s, activation time constant in 0.01 s.
 
 Shapes of :class:`TrialModel` outputs: excitations ``(n_emg, n_muscles)``, the rest
@@ -87,6 +91,7 @@ class TrialModel:
     tendon_force: cs.MX
     passive_force: cs.MX
     moments: cs.MX
+    modeled_activations: cs.MX | None = None
 
 
 class TrialChain:
@@ -109,20 +114,33 @@ class TrialChain:
         self.dt = float(np.mean(np.diff(t)))
         self.padding = trial.padding
         self.max_delay = max_delay_variable / 10.0
-        self.function = self._build()
+        self.activation_function, self.force_function = self._build()
 
     @property
     def n_coefficients(self) -> int:
         return self.spline_matrix.shape[0]
 
-    def _build(self) -> cs.Function:
+    def _build(self) -> tuple[cs.Function, cs.Function]:
         n = self.trial.n_frames
         sampler = emg_spline.delayed_sampler(self.breaks, self.sample_times, self.max_delay, "emg_delay")
-        activation = hill.neural_activation_function(self.n_emg)
+        dynamics = hill.neural_activation_function(self.n_emg)
         delay = cs.SX.sym("delay")  # 0.1 s
         tau = cs.SX.sym("tau")  # 0.01 s
         nonlin = cs.SX.sym("A")
         coefs = cs.SX.sym("coefs", self.n_coefficients)
+        e = sampler(delay / 10.0, coefs)
+        neural_all = dynamics(e, tau / 100.0, self.dt)
+        pad = self.padding
+        neural = cs.fmax(neural_all[pad : pad + n], 0)
+        act = hill.activation_nonlinearity(neural, nonlin)
+        activation = cs.Function(
+            f"mtp_activation_{self.trial.name}",
+            [delay, tau, nonlin, coefs],
+            [e, neural, act],
+            ["delay", "tau", "A", "coefs"],
+            ["e", "n", "a"],
+        )
+        a = cs.SX.sym("a", n)
         lmt = cs.SX.sym("lmt", n)
         vmt = cs.SX.sym("vmt", n)
         lo = cs.SX.sym("lo")
@@ -130,48 +148,42 @@ class TrialChain:
         alpha = cs.SX.sym("alpha")
         f0 = cs.SX.sym("F0")
         vmax = cs.SX.sym("vmax")
-        e = sampler(delay / 10.0, coefs)
-        neural_all = activation(e, tau / 100.0, self.dt)
-        pad = self.padding
-        neural = cs.fmax(neural_all[pad : pad + n], 0)
-        act = hill.activation_nonlinearity(neural, nonlin)
         lnorm = hill.normalized_fiber_length(lmt, lo, lts, alpha)
         vnorm = hill.normalized_fiber_velocity(vmt, lo, alpha, vmax)
-        force = hill.tendon_force(act, lnorm, vnorm, f0, alpha)
-        passive = hill.passive_tendon_force(lnorm, f0, alpha)
-        return cs.Function(
-            f"mtp_muscle_{self.trial.name}",
-            [delay, tau, nonlin, coefs, lmt, vmt, lo, lts, alpha, f0, vmax],
-            [e, neural, act, lnorm, vnorm, force, passive],
-            ["delay", "tau", "A", "coefs", "lmt", "vmt", "lo", "lts", "alpha", "F0", "vmax"],
-            ["e", "n", "a", "l", "v", "F", "Fp"],
+        force = cs.Function(
+            f"mtp_force_{self.trial.name}",
+            [a, lmt, vmt, lo, lts, alpha, f0, vmax],
+            [lnorm, vnorm, hill.tendon_force(a, lnorm, vnorm, f0, alpha), hill.passive_tendon_force(lnorm, f0, alpha)],
+            ["a", "lmt", "vmt", "lo", "lts", "alpha", "F0", "vmax"],
+            ["l", "v", "F", "Fp"],
         )
+        return activation, force
 
     def emg_coefficients(self, emg: np.ndarray) -> np.ndarray:
         """Spline coefficients (4 P, k) of EMG samples (n_emg, k)."""
         return self.spline_matrix @ np.asarray(emg, dtype=float)
 
-    def evaluate(
-        self,
-        muscles: MuscleParameters,
-        design: MuscleDesign,
-        excitation_samples: cs.MX,
-        vmax_factor: float,
-        *,
-        parallel: str = "serial",
-    ) -> TrialModel:
-        """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)`` (MX)."""
-        m = muscles.n_muscles
-        n = self.trial.n_frames
+    def activations(self, design: MuscleDesign, excitation_samples: cs.MX) -> tuple[cs.MX, cs.MX, cs.MX]:
+        """``(excitations (n_emg, M), neural activations (n, M), activations (n, M))``."""
+        m = int(excitation_samples.shape[1])
         coefs = cs.mtimes(cs.DM(self.spline_matrix), excitation_samples)
-        lo = cs.DM(muscles.optimal_fiber_length.reshape(1, m)) * _row(design.optimal_fiber_length_scale, m)
-        lts = cs.DM(muscles.tendon_slack_length.reshape(1, m)) * _row(design.tendon_slack_length_scale, m)
-        mapped = self.function.map(m, parallel) if parallel != "serial" else self.function.map(m)
-        out = mapped(
+        e, neural, act = self.activation_function.map(m)(
             _row(design.electromechanical_delay, m),
             _row(design.activation_time_constant, m),
             _row(design.activation_nonlinearity, m),
             coefs,
+        )
+        return e, neural, act
+
+    def forces(
+        self, muscles: MuscleParameters, design: MuscleDesign, activations: cs.MX, vmax_factor: float
+    ) -> tuple[cs.MX, cs.MX, cs.MX, cs.MX, cs.MX]:
+        """``(normalized length, normalized velocity, tendon force, passive force, moments)``."""
+        m = muscles.n_muscles
+        lo = cs.DM(muscles.optimal_fiber_length.reshape(1, m)) * _row(design.optimal_fiber_length_scale, m)
+        lts = cs.DM(muscles.tendon_slack_length.reshape(1, m)) * _row(design.tendon_slack_length_scale, m)
+        lnorm, vnorm, force, passive = self.force_function.map(m)(
+            activations,
             cs.DM(self.trial.muscle_tendon_length),
             cs.DM(self.trial.muscle_tendon_velocity),
             lo,
@@ -180,10 +192,27 @@ class TrialChain:
             cs.DM(muscles.max_isometric_force.reshape(1, m)),
             cs.DM(np.full((1, m), float(vmax_factor))),
         )
-        e, neural, act, lnorm, vnorm, force, passive = out
-        moments = joint_moments(self.trial.moment_arms, force)
-        assert moments.shape == (n, self.trial.moment_arms.shape[1])
-        return TrialModel(self.trial.name, e, excitation_samples, neural, act, lnorm, vnorm, force, passive, moments)
+        return lnorm, vnorm, force, passive, joint_moments(self.trial.moment_arms, force)
+
+    def evaluate(
+        self,
+        muscles: MuscleParameters,
+        design: MuscleDesign,
+        excitation_samples: cs.MX,
+        vmax_factor: float,
+        *,
+        activations: cs.MX | None = None,
+    ) -> TrialModel:
+        """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)`` (MX).
+
+        ``activations``: use these (e.g. lifted decision variables, constrained elsewhere
+        to equal the modeled activations) for forces and moments instead of the modeled ones.
+        """
+        e, neural, act = self.activations(design, excitation_samples)
+        used = act if activations is None else activations
+        lnorm, vnorm, force, passive, moments = self.forces(muscles, design, used, vmax_factor)
+        return TrialModel(self.trial.name, e, excitation_samples, neural, used, lnorm, vnorm, force, passive, moments,
+                          modeled_activations=act)
 
 
 def joint_moments(moment_arms: np.ndarray, forces: cs.MX) -> cs.MX:

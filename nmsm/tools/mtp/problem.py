@@ -112,20 +112,32 @@ class TaskSettings:
 
 
 def modeled_trials(
-    data: MtpData, design: MuscleDesign, synergy_weights: Any, chains: Sequence[TrialChain] | None = None
+    data: MtpData,
+    design: MuscleDesign,
+    synergy_weights: Any,
+    chains: Sequence[TrialChain] | None = None,
+    *,
+    lifted: Sequence[Any] | None = None,
+    lifted_synx: Sequence[Any] | None = None,
 ) -> tuple[list[TrialModel], list[TrialModel] | None]:
-    """Modeled quantities of every trial without and (if enabled) with SynX."""
+    """Modeled quantities of every trial without and (if enabled) with SynX.
+
+    ``lifted`` / ``lifted_synx``: per-trial activation matrices (n_frames, n_muscles) that
+    replace the modeled activations in forces and moments (see :class:`TrialModel`).
+    """
     chains = list(chains) if chains is not None else data.chains()
-    m = data.muscles.n_muscles
     plain = []
-    for chain, trial in zip(chains, data.trials):
+    for k, (chain, trial) in enumerate(zip(chains, data.trials)):
         x = scaled_emg_samples(trial.emg, data.channel_of_muscle, design.emg_scale)
-        plain.append(chain.evaluate(data.muscles, design, x, data.vmax_factor))
+        act = None if lifted is None else lifted[k]
+        plain.append(chain.evaluate(data.muscles, design, x, data.vmax_factor, activations=act))
     synx_models = None
     if data.synx is not None:
         samples = data.synx.excitation_samples(data.expanded_emg(), design.emg_scale, synergy_weights)
-        synx_models = [c.evaluate(data.muscles, design, x, data.vmax_factor) for c, x in zip(chains, samples)]
-    assert all(p.activations.shape[1] == m for p in plain)
+        synx_models = [
+            c.evaluate(data.muscles, design, x, data.vmax_factor, activations=None if lifted_synx is None else lifted_synx[k])
+            for k, (c, x) in enumerate(zip(chains, samples))
+        ]
     return plain, synx_models
 
 
@@ -146,8 +158,16 @@ def build_task_problem(
     *,
     chains: Sequence[TrialChain] | None = None,
     name: str = "MTP task",
+    lift: bool = True,
 ) -> tuple[OptimizationProblem, MtpContext]:
-    """The task's problem (variables, terms, constraints) and the terms' context."""
+    """The task's problem (variables, terms, constraints) and the terms' context.
+
+    ``lift``: activations become decision variables (``activations_<trial>``,
+    ``synx_activations_<trial>``) with equality constraints to the modeled ones. The
+    solution is the same; exact Jacobians and Hessians stay sparse (the moments couple
+    all muscles only through the linear sum of forces), which makes IPOPT with exact
+    second derivatives fast.
+    """
     problem = OptimizationProblem(name)
     m = data.muscles.n_muscles
     values: dict[str, Any] = {}
@@ -162,7 +182,19 @@ def build_task_problem(
     if data.synx is not None:
         low, high = SYNERGY_WEIGHT_BOUNDS
         weights = problem.variable("synergy_weights", np.clip(state.synergy_weights, low, high), low, high)
-    plain, synx_models = modeled_trials(data, design, weights, chains)
+    chains = list(chains) if chains is not None else data.chains()
+    lifted = lifted_synx = None
+    if lift:
+        start_plain, start_synx = _activations_at(data, state, chains)
+        lifted = [problem.variable(f"activations_{t.name}", a, scale=1.0) for t, a in zip(data.trials, start_plain)]
+        if start_synx is not None:
+            lifted_synx = [
+                problem.variable(f"synx_activations_{t.name}", a, scale=1.0) for t, a in zip(data.trials, start_synx)
+            ]
+    plain, synx_models = modeled_trials(data, design, weights, chains, lifted=lifted, lifted_synx=lifted_synx)
+    if lift:
+        for model in plain + (synx_models or []):
+            problem.add_constraint(f"lifted_activations_{model.name}", model.activations - model.modeled_activations, 0.0, 0.0)
     ctx = MtpContext(
         muscles=data.muscles,
         design=design,
@@ -189,6 +221,18 @@ def build_task_problem(
     if data.synx is not None and data.synx.method == "PCA":
         problem.add_constraint("extrapolated_excitation_0_1", data.synx.extrapolated_bounds_expression(weights), 0.0, 1.0)
     return problem, ctx
+
+
+def _activations_at(
+    data: MtpData, state: MtpState, chains: Sequence[TrialChain]
+) -> tuple[list[np.ndarray], list[np.ndarray] | None]:
+    """Numeric modeled activations (n_frames, n_muscles) per trial at ``state`` (plain, SynX)."""
+    design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
+    plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
+    outs = [m.activations for m in plain] + [m.activations for m in (synx or [])]
+    values = [np.array(v.full()) for v in cs.Function("start_activations", [], outs).call([])]
+    n = len(plain)
+    return values[:n], (values[n:] if synx is not None else None)
 
 
 def updated_state(state: MtpState, values: dict[str, np.ndarray]) -> MtpState:

@@ -103,7 +103,7 @@ def _muscle_analysis(args: argparse.Namespace) -> int:
 
     surrogate = SurrogateModel.load(args.surrogate) if args.surrogate else None
     result = analyze_motion(args.model, args.motion, muscles=args.muscles, coordinates=args.coordinates,
-                            engine=args.engine, surrogate=surrogate)
+                            engine=args.engine, surrogate=surrogate, lowpass_hz=args.lowpass)
     trial = args.trial or Path(args.motion).stem
     paths = result.write(args.output, trial)
     counts: dict[str, int] = {}
@@ -149,4 +149,6 @@ def register(subparsers: Any) -> None:
     p.add_argument("--engine", choices=["auto", "nmsm", "opensim"], default="auto",
                    help="auto: exact paths, OpenSim (or --surrogate) for wrapping muscles")
     p.add_argument("--surrogate", help="surrogate model (.json) for wrapping muscles")
+    p.add_argument("--lowpass", type=float, default=None,
+                   help="low-pass cut-off (Hz) for the coordinates, as OpenSim's AnalyzeTool (default: none)")
     p.set_defaults(func=_muscle_analysis)

@@ -13,7 +13,6 @@ import os
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 from nmsm.errors import InputError
 from nmsm.model.surrogate import SurrogateModel, fit_surrogate_model
@@ -97,6 +96,3 @@ def accuracy_report(model: SurrogateModel) -> str:
         lines.append(f"worst muscle: {worst[1]}")
     return "\n".join(lines)
 
-
-def describe(model: Any) -> str:
-    return f"surrogate of {len(model.muscles)} muscles over {len(model.coordinates)} coordinates, degree {model.degree}"

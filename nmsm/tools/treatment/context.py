@@ -238,6 +238,13 @@ class TreatmentContext(GridView):
         interpolating polynomial on its collocation points (an interval with one point: 0)."""
         return self._q.collocation_derivative() @ cs.MX(values) / self.final_time
 
+    def synergy_vector(self, name: str, *, initial: bool = False) -> Any:
+        """(1, M_g) synergy vector of ``<group>_<k>`` (MX; numpy when ``initial``)."""
+        for controller in self._q.data.controllers:
+            if name in getattr(controller, "synergy_names", ()):
+                return controller.synergy_vector(name, initial=initial)
+        raise KeyError(f"no synergy '{name}'")
+
     def integrate(self, values: Any) -> cs.MX:
         """``integral_0^1 values ds`` over normalized time of (K, m) values -> (1, m)."""
         w = cs.DM(self._q.trajectory.quadrature_weights).T
@@ -339,6 +346,12 @@ class TreatmentContext(GridView):
         if refs is None or not refs.has(muscle):
             raise term.error(f"no reference activation for muscle '{muscle}' (<trial>_combinedActivations.sto "
                              "in the initial guess directory)", element=element)
+
+    def require_synergy(self, term: Any, name: str, element: str = "<synergy_list>") -> None:
+        names = [n for c in self._q.data.controllers for n in getattr(c, "synergy_names", ())]
+        if name not in names:
+            raise term.error(f"'{name}' is not a synergy of the synergy controller", element=element,
+                             expected="one of " + (", ".join(names) or "(no synergy controller)"))
 
     def require_parameter(self, term: Any, name: str, element: str = "<type>") -> None:
         if name not in self._q.data.parameters:

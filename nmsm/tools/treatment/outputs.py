@@ -35,7 +35,7 @@ def write_table(path: Path, time: np.ndarray, labels: Sequence[str], values: np.
 
 
 def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None = None,
-                   extra_tables: Mapping[str, tuple[Sequence[str], np.ndarray]] | None = None) -> list[Path]:
+                   extra_tables: Mapping[str, tuple] | None = None) -> list[Path]:
     """Write every output file of ``tsol`` into ``stage``; returns the paths."""
     built = tsol.built
     data = built.data
@@ -50,13 +50,16 @@ def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None 
     sc = data.state_coordinates
     out.append(write_table(stage / f"{trial}_states.sto", t, list(sc) + [speed_label(c) for c in sc], tsol.states))
     out.append(write_table(stage / f"{trial}_accelerations.sto", t, sc, tsol.state_accelerations))
-    tables: dict[str, tuple[Sequence[str], np.ndarray]] = {}
+    tables: dict[str, tuple] = {}
     for controller in data.controllers:
         tables.update(controller.output_tables(tsol))
     tables.update(extra_tables or {})
-    for name, (labels, values) in tables.items():
-        values = np.asarray(values, dtype=float)
-        time = t if values.shape[0] == t.size else np.arange(values.shape[0], dtype=float)
+    for name, entry in tables.items():
+        labels, values = entry[0], np.asarray(entry[1], dtype=float)
+        if len(entry) > 2:
+            time = np.asarray(entry[2], dtype=float)
+        else:
+            time = t if values.shape[0] == t.size else np.arange(1.0, values.shape[0] + 1)
         out.append(write_table(stage / name, time, labels, values))
     # tracked vs modeled kinematics of the states, on the same times
     ref_t = tsol.view.normalized_time * data.reference_duration

@@ -1,0 +1,1 @@
+"""Joint Model Personalization cost terms (``tools = {"JMP"}``)."""

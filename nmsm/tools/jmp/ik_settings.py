@@ -1,0 +1,150 @@
+"""OpenSim inverse-kinematics settings files (``<OpenSimDocument><InverseKinematicsTool>``).
+
+Read: the IKTaskSet (``IKMarkerTask`` name/apply/weight, ``IKCoordinateTask``
+name/apply/weight/value_type/value), ``accuracy``, ``time_range``, ``marker_file``,
+``coordinate_file``, ``model_file`` and ``output_motion_file``. Paths resolve as settings
+paths do (:func:`nmsm.io.paths.resolve_path`: the file's folder, then its parent — the
+tutorial's ``IKSettingsFiles/*.xml`` name ``MarkerFiles/...`` of the step folder). Empty
+paths and ``Unassigned`` mean "not given".
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import attrs
+from lxml import etree
+
+from nmsm.errors import InputError
+from nmsm.io.paths import resolve_path
+
+_UNSET = {"", "unassigned"}
+
+
+@attrs.frozen
+class CoordinateTask:
+    """Track a coordinate: ``weight * (q - value)**2`` (rad or m).
+
+    ``value_type`` is ``default_value`` (the model's default), ``manual_value`` (``value``)
+    or ``from_file`` (the settings' coordinate file).
+    """
+
+    name: str
+    weight: float
+    value_type: str = "default_value"
+    value: float = 0.0
+
+
+@attrs.frozen
+class IkSettings:
+    """What nmsm's inverse kinematics reads from an OpenSim IK settings file."""
+
+    file: Path
+    marker_weights: dict[str, float] | None
+    coordinate_tasks: tuple[CoordinateTask, ...] = ()
+    accuracy: float | None = None
+    time_range: tuple[float, float] | None = None
+    marker_file: Path | None = None
+    coordinate_file: Path | None = None
+    model_file: Path | None = None
+    output_motion_file: Path | None = None
+    constraint_weight: float = math.inf
+
+
+def _text(elem: etree._Element, tag: str) -> str | None:
+    child = elem.find(tag)
+    if child is None or child.text is None:
+        return None
+    text = child.text.strip()
+    return None if text.lower() in _UNSET else text
+
+
+def _number(path: Path, elem: etree._Element, tag: str, text: str) -> float:
+    try:
+        return float(text.replace("Inf", "inf").replace("INF", "inf"))
+    except ValueError:
+        raise InputError(f"<{tag}> = '{text}' is not a number", file=path, line=elem.sourceline,
+                         element=f"<{tag}>", expected="a number") from None
+
+
+def _bool(path: Path, elem: etree._Element, text: str | None) -> bool:
+    value = (text or "true").strip().lower()
+    if value not in ("true", "false"):
+        raise InputError(f"<apply> = '{text}'", file=path, line=elem.sourceline, element="<apply>",
+                         expected="true or false")
+    return value == "true"
+
+
+def read_ik_settings(path: str | os.PathLike[str]) -> IkSettings:
+    """Parse an OpenSim IK settings file (see module docstring)."""
+    path = Path(path)
+    try:
+        root = etree.parse(str(path)).getroot()
+    except OSError as exc:
+        raise InputError(f"cannot read the IK settings file ({exc})", file=path) from None
+    except etree.XMLSyntaxError as exc:
+        raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from None
+    tool = root if root.tag == "InverseKinematicsTool" else root.find("InverseKinematicsTool")
+    if tool is None:
+        raise InputError("no <InverseKinematicsTool> element", file=path, line=root.sourceline,
+                         expected="an OpenSim inverse-kinematics settings file")
+    weights: dict[str, float] | None = None
+    coordinate_tasks: list[CoordinateTask] = []
+    task_set = tool.find("IKTaskSet")
+    if task_set is not None:
+        weights = {}
+        for task in task_set.iter("IKMarkerTask", "IKCoordinateTask"):
+            name = task.get("name")
+            if not name:
+                raise InputError(f"<{task.tag}> without a name", file=path, line=task.sourceline,
+                                 element=f"<{task.tag}>", expected='name="marker or coordinate"')
+            if not _bool(path, task, _text(task, "apply")):
+                continue
+            weight_text = _text(task, "weight")
+            weight = 1.0 if weight_text is None else _number(path, task, "weight", weight_text)
+            if task.tag == "IKMarkerTask":
+                weights[name] = weight
+                continue
+            value_type = (_text(task, "value_type") or "default_value").strip()
+            if value_type not in ("default_value", "manual_value", "from_file"):
+                raise InputError(f"<value_type> = '{value_type}'", file=path, line=task.sourceline,
+                                 element="<value_type>", expected="default_value, manual_value or from_file")
+            value_text = _text(task, "value")
+            value = 0.0 if value_text is None else _number(path, task, "value", value_text)
+            coordinate_tasks.append(CoordinateTask(name, weight, value_type, value))
+        if not weights and not coordinate_tasks:
+            weights = None
+    accuracy_text = _text(tool, "accuracy")
+    time_text = _text(tool, "time_range")
+    time_range = None
+    if time_text is not None:
+        parts = time_text.split()
+        if len(parts) != 2:
+            raise InputError(f"<time_range> = '{time_text}'", file=path, element="<time_range>",
+                             expected="two numbers: start and end time (s)")
+        time_range = (_number(path, tool, "time_range", parts[0]), _number(path, tool, "time_range", parts[1]))
+    constraint_text = _text(tool, "constraint_weight")
+
+    def file_path(tag: str, must_exist: bool) -> Path | None:
+        text = _text(tool, tag)
+        if text is None:
+            return None
+        elem = tool.find(tag)
+        return resolve_path(text, settings_file=path, line=elem.sourceline, element=tag,
+                            must_exist=must_exist, kind="file" if must_exist else "any")
+
+    return IkSettings(
+        file=path,
+        marker_weights=weights,
+        coordinate_tasks=tuple(coordinate_tasks),
+        accuracy=None if accuracy_text is None else _number(path, tool, "accuracy", accuracy_text),
+        time_range=time_range,
+        marker_file=file_path("marker_file", True),
+        coordinate_file=file_path("coordinate_file", True),
+        model_file=file_path("model_file", True),
+        output_motion_file=file_path("output_motion_file", False),
+        constraint_weight=math.inf if constraint_text is None else _number(path, tool, "constraint_weight",
+                                                                            constraint_text),
+    )

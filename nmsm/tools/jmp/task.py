@@ -1,0 +1,118 @@
+"""One JMP task: design, inverse kinematics before, the joint solve, the new model, IK after.
+
+:func:`run_task` takes the model the task starts from (the input model, or the previous
+task's output: tasks are chained, each starting from the model the previous one wrote;
+the original takes every task's initial values and bounds from the input model, which
+only matters for a parameter optimized by two tasks) and writes the task's model to
+``output``.
+
+Inverse kinematics before and after use the task's markers with weight 1 and the
+settings' ``accuracy``; "after" runs on the written ``.osim`` read back, so it checks the
+file as well as the optimization.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import attrs
+import numpy as np
+
+from nmsm.io.settings.jmp import JmpTask
+from nmsm.io.trc import read_trc
+from nmsm.model.osim import load_model
+from nmsm.terms.jmp.marker_distance import MarkerDistanceError
+from nmsm.tools.jmp.design import TaskDesign, build_design
+from nmsm.tools.jmp.ik import IkResult, inverse_kinematics
+from nmsm.tools.jmp.levenberg_marquardt import Tolerances
+from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, select_trial
+from nmsm.tools.jmp.marker_model import MarkerKinematics
+from nmsm.tools.jmp.model_output import write_task_model
+from nmsm.tools.jmp.problem import JmpProblem, JmpSolution
+
+#: joints whose coordinates move less than this over a task's trial get a warning (rad)
+MIN_RANGE_OF_MOTION = np.radians(25.0)
+
+
+@attrs.frozen(eq=False)
+class TaskResult:
+    """Outcome of one task (see module docstring); ``output`` is the model it wrote."""
+
+    task: JmpTask
+    label: str
+    design: TaskDesign
+    trial: MarkerTrial
+    solution: JmpSolution
+    before: IkResult
+    after: IkResult
+    output: Path
+    notes: tuple[str, ...]
+
+    @property
+    def values(self) -> np.ndarray:
+        return self.solution.p
+
+
+def task_label(task: JmpTask, position: int) -> str:
+    return f"Task {task.index if task.index is not None else position} '{task.name or 'unnamed'}'"
+
+
+def _warn_small_motion(model_label: str, design: TaskDesign, task: JmpTask, before: IkResult,
+                       settings_file: str | None) -> list[str]:
+    notes = []
+    model = design.parameters.model
+    for joint in task.joints:
+        coordinates = [c for c in model.joint(joint.name).coordinates
+                       if c in before.free_names and model.coordinate(c).motion_type == "rotational"]
+        if not coordinates:
+            continue
+        ranges = {c: float(np.ptp(before.coordinate(c))) for c in coordinates}
+        if max(ranges.values()) < MIN_RANGE_OF_MOTION:
+            text = (f"joint '{joint.name}' moves little in {task.marker_file_name.name} ("
+                    + ", ".join(f"{c} {np.degrees(r):.1f} deg" for c, r in ranges.items())
+                    + f" < {np.degrees(MIN_RANGE_OF_MOTION):.0f} deg): its parameters are unreliable")
+            warnings.warn(f"{settings_file}: {model_label}: {text}", stacklevel=3)
+            notes.append(text)
+    return notes
+
+
+def run_task(model_file: Path, task: JmpTask, position: int, *, allowable_error: float, tolerances: Tolerances,
+             ik_accuracy: float | None, output: Path, settings_file: str | None = None,
+             log: Callable[[str], None] = print) -> TaskResult:
+    """Run ``task`` on the model in ``model_file`` and write the personalized model to ``output``."""
+    label = task_label(task, position)
+    model = load_model(model_file)
+    table = read_trc(task.marker_file_name)
+    design = build_design(model, task, table.names, settings_file=settings_file)
+    trial = select_trial(table, model, {m: 1.0 for m in design.marker_names}, time_range=task.time_range,
+                         settings_file=settings_file)
+    kinematics = MarkerKinematics(model, trial.names, design.parameters,
+                                  unscaled_marker_bodies=design.unscaled_marker_bodies)
+    p0 = design.initial
+    q_default = kinematics.initial_free()
+    trial, factor = check_units(trial, kinematics.marker_positions(q_default[None, :], p0)[0])
+    log(f"{label}: {trial.n_markers} markers, {trial.n_frames} frames ({trial.time[0]:g}-{trial.time[-1]:g} s), "
+        f"{kinematics.n_free} coordinates, {len(design.variables)} parameters")
+    before = inverse_kinematics(model, trial, accuracy=ik_accuracy, kinematics=kinematics, parameters=design.parameters,
+                                parameter_values=p0, check_marker_units=False)
+    before = attrs.evolve(before, unit_factor=factor)
+    notes = _warn_small_motion(label, design, task, before, settings_file)
+    q0 = before.q[:, [before.coordinate_names.index(n) for n in kinematics.free_names]]
+    term = MarkerDistanceError(max_allowable_error=allowable_error, name=task.name, source=task.source)
+    problem = JmpProblem(kinematics, trial, [term], design.lower, design.upper)
+    solution = problem.solve(q0, p0, tolerances)
+    log(f"{label}: {solution.status} after {solution.iterations} iterations ({solution.wall_time:.1f} s); "
+        f"cost {solution.initial_cost:.6g} -> {solution.cost:.6g}")
+    if not solution.converged:
+        warnings.warn(f"{settings_file}: {label}: the optimization stopped before converging ({solution.status})",
+                      stacklevel=2)
+    notes += write_task_model(model, Path(model_file), design, solution.p, output,
+                              anatomical_markers=task.anatomical_markers)
+    written = load_model(output)
+    after = inverse_kinematics(written, trial, accuracy=ik_accuracy, check_marker_units=False)
+    log(f"{label}: marker RMS {1000 * before.marker_rms():.3f} -> {1000 * after.marker_rms():.3f} mm, "
+        f"max {1000 * before.marker_max():.3f} -> {1000 * after.marker_max():.3f} mm")
+    return TaskResult(task=task, label=label, design=design, trial=trial, solution=solution, before=before,
+                      after=after, output=output, notes=tuple(notes))

@@ -1,0 +1,150 @@
+"""Muscle forces and joint moments for treatment controllers (spec tools.md §0.4, §8.3-2).
+
+Geometry comes from a fitted surrogate (:mod:`nmsm.model.surrogate`: lengths, velocities
+and moment arms as polynomials of the surrogate coordinates); forces from the rigid-tendon
+Hill model (:mod:`nmsm.model.hill`)::
+
+    l̃ = (L - l_ts) / (l_o cos α),   ṽ = V / (vmax l_o cos α)
+    F = F0 (a f_L(l̃) f_V(ṽ) + f_P(l̃)) cos α,   M_j = Σ_m r_mj F_m
+
+Parameters per muscle: ``max_isometric_force`` F0 (N), ``optimal_fiber_length`` l_o (m),
+``tendon_slack_length`` l_ts (m) from the ``.osimx`` when it has them (matched by name; the
+original matches by list position, a bug) else from the ``.osim``; pennation α (rad) from the
+``.osim``; ``vmax`` = ``maximum_shortening_velocity_multiplier`` (l_o/s). Parameters may be
+replaced by CasADi expressions (Design Optimization model modifiers).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import attrs
+import casadi as cs
+import numpy as np
+
+from nmsm.errors import InputError
+from nmsm.model import hill
+from nmsm.model.surrogate import SurrogateModel
+from nmsm.tools.treatment.transcription.base import map_rows
+
+PARAMETERS = ("max_isometric_force", "optimal_fiber_length", "tendon_slack_length")
+
+_SURROGATE_CACHE: dict[tuple[Any, ...], SurrogateModel] = {}
+
+
+def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLike[str] | str,
+                   coordinates: Sequence[str], *, degree: int, epsilon: float, load: bool = False,
+                   save: bool = False, settings_file: os.PathLike[str] | str | None = None) -> SurrogateModel:
+    """Fit (or load/save, as the settings ask) the surrogate of the synergy controller;
+    fits are cached per process (same data, coordinates, degree and epsilon)."""
+    from nmsm.tools.surrogate.settings import SurrogateSettings
+    from nmsm.tools.surrogate.tool import surrogate_from_settings
+
+    key = (str(Path(model_file).resolve()), str(Path(data_directory).resolve()), tuple(coordinates), degree, epsilon)
+    if key in _SURROGATE_CACHE and not (load or save):
+        return _SURROGATE_CACHE[key]
+    base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
+    settings = SurrogateSettings(model_file=Path(model_file), data_directory=Path(data_directory),
+                                 coordinates=tuple(coordinates), epsilon=epsilon, degree=degree, load=load, save=save,
+                                 model_path=base / "surrogateMuscles.json",
+                                 settings_file=Path(settings_file) if settings_file else None)
+    model = surrogate_from_settings(settings)
+    _SURROGATE_CACHE[key] = model
+    return model
+
+
+@attrs.define
+class MuscleModel:
+    """Muscles of a controller: names, surrogate geometry, Hill parameters.
+
+    ``parameters[name]`` -> {``max_isometric_force``, ``optimal_fiber_length``,
+    ``tendon_slack_length``}: floats or MX expressions; ``pennation`` (M,) rad.
+    """
+
+    muscles: tuple[str, ...]
+    coordinates: tuple[str, ...]
+    surrogate: SurrogateModel
+    parameters: dict[str, dict[str, Any]]
+    pennation: np.ndarray
+    vmax_factor: float = hill.DEFAULT_VMAX_FACTOR
+    _function: cs.Function | None = attrs.field(default=None, init=False, repr=False)
+
+    @classmethod
+    def build(cls, muscles: Sequence[str], coordinates: Sequence[str], surrogate: SurrogateModel, osim_model: Any,
+              osimx: Any, vmax_factor: float, *, where: Any = None) -> MuscleModel:
+        """Parameters from the ``.osim`` model (``nmsm.model.Model``) and ``.osimx`` overrides."""
+        missing = [m for m in muscles if m not in surrogate.muscle_names]
+        if missing:
+            raise InputError(f"muscle(s) {', '.join(missing)} have no surrogate geometry (no moment arm above epsilon "
+                             "on the surrogate coordinates, or missing from the surrogate data)", file=where,
+                             element="<surrogate_model_coordinate_list>",
+                             expected="surrogate coordinates spanned by every synergy muscle")
+        params: dict[str, dict[str, Any]] = {}
+        pennation = []
+        overrides = getattr(osimx, "muscles", {}) if osimx is not None else {}
+        for name in muscles:
+            try:
+                muscle = osim_model.muscle(name)
+            except KeyError as exc:
+                raise InputError(str(exc), file=where, expected="muscles of the model") from exc
+            values = {key: float(getattr(muscle, key)) for key in PARAMETERS}
+            override = overrides.get(name)
+            if override is not None:
+                for key in PARAMETERS:
+                    value = getattr(override, key, None)
+                    if value is not None:
+                        values[key] = float(value)
+            params[name] = values
+            pennation.append(float(muscle.pennation_angle_at_optimal))
+        return cls(tuple(muscles), tuple(coordinates), surrogate, params, np.asarray(pennation), float(vmax_factor))
+
+    @property
+    def n(self) -> int:
+        return len(self.muscles)
+
+    def set_parameter(self, muscle: str, name: str, value: Any) -> None:
+        """Replace a parameter (``PARAMETERS``) of ``muscle`` by a value or MX expression."""
+        if muscle not in self.parameters:
+            raise KeyError(f"muscle '{muscle}' is not driven by this controller (have: {', '.join(self.muscles)})")
+        if name not in PARAMETERS:
+            raise KeyError(f"unknown muscle parameter '{name}' (expected one of {', '.join(PARAMETERS)})")
+        self.parameters[muscle][name] = value
+
+    def parameter_row(self) -> cs.MX:
+        """(1, 3 M) [F0..., l_o..., l_ts...] as MX (constants or modifier expressions)."""
+        cols = [cs.MX(self.parameters[m][key]) for key in PARAMETERS for m in self.muscles]
+        return cs.horzcat(*cols)
+
+    def point_function(self) -> cs.Function:
+        """SX ``(q_c, qd_c, a, p) -> (forces (M,), moments (n_c,), l̃ (M,), ṽ (M,))`` of one point;
+        ``q_c``/``qd_c`` over :attr:`coordinates`, ``a`` activations, ``p`` = parameter row."""
+        if self._function is None:
+            geometry = self.surrogate.function(self.coordinates, self.muscles)
+            nc, M = len(self.coordinates), self.n
+            q, qd, a = cs.SX.sym("q", nc), cs.SX.sym("qd", nc), cs.SX.sym("a", M)
+            p = cs.SX.sym("p", 3 * M)
+            F0, lo, lts = p[:M], p[M:2 * M], p[2 * M:]
+            lengths, velocities, arms = geometry(q, qd)
+            alpha = cs.DM(self.pennation)
+            l_norm = hill.normalized_fiber_length(lengths, lo, lts, alpha)
+            v_norm = hill.normalized_fiber_velocity(velocities, lo, alpha, self.vmax_factor)
+            forces = hill.tendon_force(a, l_norm, v_norm, F0, alpha)
+            moments = cs.mtimes(arms.T, forces)
+            self._function = cs.Function("muscle_forces", [q, qd, a, p], [forces, moments, l_norm, v_norm])
+        return self._function
+
+    def evaluate(self, view: Any, activations: cs.MX, parallel: int = 1) -> list[cs.MX]:
+        """[forces (n, M), moments (n, n_c), l̃ (n, M), ṽ (n, M)] on a grid view."""
+        Q = cs.horzcat(*[view.coordinate(c) for c in self.coordinates])
+        Qd = cs.horzcat(*[view.speed(c) for c in self.coordinates])
+        return map_rows(self.point_function(), Q, Qd, activations, self.parameter_row(), parallel=parallel)
+
+
+def check_activation_range(values: np.ndarray, where: str) -> None:
+    """Warn when activations leave [0, 1] (synergy products can)."""
+    if values.size and (values.min() < -1e-6 or values.max() > 1 + 1e-6):
+        warnings.warn(f"{where}: activations span [{values.min():.3g}, {values.max():.3g}], outside [0, 1]", stacklevel=2)

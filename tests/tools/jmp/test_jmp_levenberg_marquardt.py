@@ -1,0 +1,78 @@
+"""The bound-constrained Levenberg-Marquardt solver and its three linear-algebra back ends."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.optimize
+import scipy.sparse
+
+from nmsm.tools.jmp.levenberg_marquardt import (
+    BlockArrowJacobian,
+    DenseJacobian,
+    SparseJacobian,
+    Tolerances,
+    solve,
+)
+
+
+def _block_to_dense(jac: BlockArrowJacobian) -> np.ndarray:
+    f, m, n, k = jac.shape
+    dense = np.zeros((f * m, f * n + k))
+    for i in range(f):
+        dense[i * m:(i + 1) * m, i * n:(i + 1) * n] = jac.dq[i]
+        dense[i * m:(i + 1) * m, f * n:] = jac.dp[i]
+    return dense
+
+
+def test_block_arrow_step_equals_dense_step_with_fixed_variables():
+    rng = np.random.default_rng(0)
+    f, m, n, k = 7, 9, 3, 4
+    block = BlockArrowJacobian(rng.normal(size=(f, m, n)), rng.normal(size=(f, m, k)))
+    dense = DenseJacobian(_block_to_dense(block))
+    sparse = SparseJacobian(scipy.sparse.csc_matrix(dense.matrix))
+    r = rng.normal(size=f * m)
+    g = dense.gradient(r)
+    np.testing.assert_allclose(block.gradient(r), g, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(sparse.gradient(r), g, rtol=1e-12, atol=1e-12)
+    diag = dense.normal_diagonal()
+    np.testing.assert_allclose(block.normal_diagonal(), diag, rtol=1e-12)
+    np.testing.assert_allclose(sparse.normal_diagonal(), diag, rtol=1e-12)
+    free = np.ones(f * n + k, dtype=bool)
+    free[[1, 5, f * n + 2]] = False  # a coordinate of two frames and one parameter held
+    expected = dense.damped_step(g, free, 0.3, diag)
+    assert np.all(expected[~free] == 0)
+    np.testing.assert_allclose(block.damped_step(g, free, 0.3, diag), expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(sparse.damped_step(g, free, 0.3, diag), expected, rtol=1e-9, atol=1e-12)
+    s = rng.normal(size=f * n + k)
+    assert block.squared_norm_of_product(s) == pytest.approx(dense.squared_norm_of_product(s), rel=1e-12)
+
+
+def _rosenbrock(x: np.ndarray) -> tuple[np.ndarray, DenseJacobian]:
+    r = np.array([10.0 * (x[1] - x[0] ** 2), 1.0 - x[0]])
+    jac = np.array([[-20.0 * x[0], 10.0], [-1.0, 0.0]])
+    return r, DenseJacobian(jac)
+
+
+def test_unconstrained_minimum_found():
+    result = solve(_rosenbrock, np.array([-1.2, 1.0]))
+    assert result.converged
+    np.testing.assert_allclose(result.x, [1.0, 1.0], atol=1e-9)
+    assert result.cost < 1e-20
+
+
+def test_active_bound_matches_scipy():
+    lower, upper = np.array([-2.0, -2.0]), np.array([0.5, 2.0])
+    result = solve(_rosenbrock, np.array([-1.2, 1.0]), lower, upper)
+    reference = scipy.optimize.least_squares(lambda x: _rosenbrock(x)[0], [-1.2, 1.0],
+                                             jac=lambda x: _rosenbrock(x)[1].matrix, bounds=(lower, upper),
+                                             xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    assert result.converged
+    assert result.x[0] == pytest.approx(0.5, abs=1e-12)  # on the bound
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-8)
+
+
+def test_evaluation_budget_reported_as_not_converged():
+    result = solve(_rosenbrock, np.array([-1.2, 1.0]), tolerances=Tolerances(max_evaluations=3))
+    assert not result.converged
+    assert result.status == "maximum evaluations reached"
