@@ -1,8 +1,9 @@
 """The OpenSim model in nmsm: read from ``.osim`` with lxml and built as CasADi functions.
 
-``load_model(path) -> Model`` (plain data, no CasADi) and ``CasadiModel(model, parameters)``
-(CasADi functions: kinematics, inverse dynamics, ...). ``CasadiModel`` and
-``ModelParameters`` are imported lazily so that importing this package does not load CasADi.
+``load_model(path) -> Model`` (plain data, no CasADi), ``CasadiModel(model, parameters)``
+(CasADi functions: kinematics, inverse dynamics, ...), ``ModelParameters`` (symbolic
+joint frames, marker locations, body scales) and ``OsimWriter`` (write changes back into
+the file). The last three are imported lazily, so importing this package loads no CasADi.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from typing import Any
 from nmsm.model.components import Model
 from nmsm.model.osim import load_model
 
-__all__ = ["CasadiModel", "Model", "ModelParameters", "load_model"]
+__all__ = ["CasadiModel", "Model", "ModelParameters", "OsimWriter", "load_model"]
 
 
 def __getattr__(name: str) -> Any:
@@ -24,4 +25,8 @@ def __getattr__(name: str) -> Any:
         from nmsm.model.parameters import ModelParameters
 
         return ModelParameters
+    if name == "OsimWriter":
+        from nmsm.model.osim_writer import OsimWriter
+
+        return OsimWriter
     raise AttributeError(f"module 'nmsm.model' has no attribute '{name}'")

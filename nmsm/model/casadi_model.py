@@ -337,6 +337,27 @@ class CasadiModel:
 
         return self._function(("id", bodies, applied_forces, include_contact, gravity), build)
 
+    def inverse_dynamics_jacobian_function(self, load_bodies: Sequence[str] = (), *,
+                                           include_contact: bool = False) -> cs.Function:
+        """``(q, qdot, qddot[, loads][, p]) -> (tau, dtau/dq, dtau/dqdot, dtau/dqddot)``: inverse
+        dynamics and its exact Jacobian blocks (n x n each; the last is the mass matrix)."""
+        bodies = tuple(load_bodies)
+
+        def build() -> cs.Function:
+            f = self.inverse_dynamics_function(bodies, include_contact=include_contact)
+            inputs = [self.q, self.qdot, self.qddot]
+            names = ["q", "qdot", "qddot"]
+            if bodies:
+                loads = cs.SX.sym("loads", 9, len(bodies))
+                inputs.append(loads)
+                names.append("loads")
+            tau = f(*self._args(inputs, None))
+            blocks = [cs.jacobian(tau, v) for v in (self.q, self.qdot, self.qddot)]
+            return cs.Function("inverse_dynamics_jacobian", self._inputs(*inputs), [tau, *blocks],
+                               self._input_names(*names), ["tau", "dtau_dq", "dtau_dqdot", "dtau_dqddot"])
+
+        return self._function(("id_jacobian", bodies, include_contact), build)
+
     def mass_matrix_function(self) -> cs.Function:
         """``(q[, p]) -> M`` (n x n) mass matrix."""
 

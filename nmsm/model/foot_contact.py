@@ -116,6 +116,36 @@ def friction_forces(vertical_force: Any, x_velocity: Any, z_velocity: Any, belt_
     return ux * scale, uz * scale
 
 
+def unit_loads(positions: Any, velocities: Any, parameters: Any, reference: Any) -> tuple[Any, Any]:
+    """The resultant as a linear function of the spring constants: ``(A 6 x n, b 6 x 1)``
+    with ``[force; moment] = A K + b`` (N, N m), exactly :func:`contact_function`.
+
+    ``F_el`` is linear in ``K``: with ``y`` the clamped height and
+    ``g(y) = (c/2)(lc((y + h_off)/c) - lc((y_max + h_off)/c))``,
+    ``F_el = K (y_max - y)/2 + K g + k_low ((y_max - y)/2 - g)``; damping and friction
+    multiply it by factors independent of ``K``. Exposing ``A`` lets a caller form the
+    resultant with a matrix product, so derivatives with respect to ``K`` never pass
+    through the per-spring expressions (much cheaper Jacobians over many frames).
+    """
+    damping, mu_d, mu_v, rest, latch, belt = (parameters[i] for i in range(6))
+    y = HEIGHT_CLAMP * cs.tanh((positions[1, :] - rest) / HEIGHT_CLAMP)
+    g = 0.5 * CURVATURE * (_log_cosh((y + H_OFFSET) / CURVATURE) - _log_cosh((Y_MAX + H_OFFSET) / CURVATURE))
+    linear = 0.5 * (Y_MAX - y)
+    per_k = linear + g
+    constant = K_LOW * (linear - g)
+    damp = 1.0 - damping * velocities[1, :]
+    gx, gz = friction_forces(damp, velocities[0, :], velocities[2, :], belt, mu_d, mu_v, latch)
+    unit = cs.vertcat(gx, damp, gz)  # force per unit F_el, (3, n)
+    n = positions.shape[1]
+    dx = positions[0, :] - cs.repmat(reference[0], 1, n)
+    dz = positions[2, :] - cs.repmat(reference[2], 1, n)
+    unit_moment = cs.vertcat(-dz * unit[1, :], dz * unit[0, :] - dx * unit[2, :], dx * unit[1, :])
+    unit_load = cs.vertcat(unit, unit_moment)  # (6, n)
+    a = unit_load * cs.repmat(per_k, 6, 1)
+    b = cs.sum2(unit_load * cs.repmat(constant, 6, 1))
+    return a, b
+
+
 def spring_forces(positions: Any, velocities: Any, spring_constants: Any, parameters: Any) -> Any:
     """Forces (3, n) of ``n`` springs on their bodies (N, ground).
 

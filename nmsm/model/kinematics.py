@@ -38,17 +38,6 @@ class BodyState:
     a: Any = None
 
 
-@attrs.define
-class JointState:
-    """What the dynamics needs per joint: the parent frame F orientation in ground, the
-    child frame M origin in ground, and the motion subspace (expressed in F)."""
-
-    R_GF: Any
-    o_M: Any
-    H_w: Any
-    H_v: Any
-
-
 class TreeKinematics:
     """Kinematics of ``model`` with optional symbolic ``parameters`` (SX expressions)."""
 
@@ -116,13 +105,10 @@ class TreeKinematics:
         return mass, cs.DM(b.mass_center) * s, inertia
 
     # ------------------------------------------------------------------ recursion
-    def forward(self, q: Any, u: Any = None, udot: Any = None,
-                joint_states: list[JointState] | None = None) -> dict[str, BodyState]:
-        """Body states for coordinates ``q`` (and speeds ``u``, rates ``udot`` when given).
-
-        ``q``, ``u``, ``udot`` are SX vectors of length n (model coordinate order). When
-        ``joint_states`` is a list, it receives one :class:`JointState` per joint (tree order).
-        """
+    def forward(self, q: Any, u: Any = None, udot: Any = None) -> dict[str, BodyState]:
+        """Body states (ground frame) for coordinates ``q`` and, when given, speeds ``u`` and
+        their rates ``udot`` (SX vectors of length n, model coordinate order). Gravity is
+        not included in the accelerations."""
         with_velocity = u is not None
         with_acceleration = udot is not None
         zero3 = cs.DM.zeros(3, 1)
@@ -142,8 +128,6 @@ class TreeKinematics:
             r_gc = cs.mtimes(cs.mtimes(r_gf, r_fm), r_cm.T)
             s_vec = -cs.mtimes(r_gc, p_cm)  # M origin -> child origin
             state = BodyState(r_gc, o_m + s_vec)
-            if joint_states is not None:
-                joint_states.append(JointState(r_gf, o_m, h_w, h_v))
             if with_velocity:
                 w_rel = cs.mtimes(r_gf, cs.mtimes(h_w, uj)) if idx else zero3
                 v_rel = cs.mtimes(r_gf, cs.mtimes(h_v, uj)) if idx else zero3

@@ -238,9 +238,8 @@ class _Parser:
                 raise r.error(elem, f"has {len(xml_coords)} coordinates", expected=f"{len(motions)} for a {elem.tag}")
             order = [c.get("name", "") for c in xml_coords]
             order += [f"{name}_coord_{i}" for i in range(len(order), len(motions))]
-        for element_index, cname in enumerate(order):
-            cpath = f"{path}/{cname}"
-            self.coordinate_paths[cpath] = cname
+        for cname in order:
+            self.coordinate_paths[f"{path}/{cname}"] = cname
         coords = [self._coordinate(by_name.get(cname), cname, name, motion) for cname, motion in zip(order, motions)]
         joint = Joint(name, elem.tag, path, parent, child, parent_body, child_body, tuple(order), axes,
                       xml_line=elem.sourceline)

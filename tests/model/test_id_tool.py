@@ -97,3 +97,36 @@ def test_external_loads_errors(shared_data: Path, tmp_path: Path) -> None:
     assert [f.body for f in loads.forces] == ["calcn_l", "calcn_r"]
     with pytest.raises(InputError, match="cover"):
         sample_loads(loads, np.array([0.0, 10.0]))
+
+
+def test_loads_expressed_in_body_frames_match_opensim(shared_data: Path, bridge, tmp_path: Path) -> None:
+    """Forces given in a body's frame and points fixed in a body, converted with the motion's
+    kinematics (as OpenSim's ExternalForce does)."""
+    from nmsm.io.storage import table_from_columns, write_storage
+
+    model_path = shared_data / MTP / "UF_Subject_3_reduced_muscles.osim"
+    motion = shared_data / MTP / "preprocessed" / "IKData" / "gait_1.sto"
+    grf = read_storage(shared_data / MTP / "preprocessed" / "GRFData" / "gait_1.sto")
+    columns = {label: grf.column(label) for label in grf.labels}
+    n = grf.n_rows
+    for axis, value in zip("xyz", (0.12, -0.03, 0.01)):
+        columns[f"ground_force_2_p{axis}"] = np.full(n, value)  # a point fixed in calcn_r (m)
+    data = tmp_path / "grf_body.sto"
+    write_storage(data, table_from_columns(grf.time, columns, name="grf"))
+    from lxml import etree
+
+    tree = etree.parse(str(shared_data / PRE / "externalLoads.xml"))
+    tree.find(".//datafile").text = str(data)
+    left, right = tree.findall(".//ExternalForce")
+    left.find("force_expressed_in_body").text = "calcn_l"  # the raw numbers read as calcn_l-frame forces
+    right.find("point_expressed_in_body").text = "calcn_r"
+    loads_path = tmp_path / "loads_body.xml"
+    tree.write(str(loads_path))
+    loads = read_external_loads(loads_path)
+    assert [(f.force_frame, f.point_frame) for f in loads.forces] == [("calcn_l", "ground"), ("ground", "calcn_r")]
+    out = tmp_path / "opensim_id.sto"
+    bridge.call("oracle_inverse_dynamics_tool", model_path=str(model_path), coordinates_file=str(motion),
+                output_file=str(out), external_loads_file=str(loads_path), lowpass_hz=6.0)
+    reference = read_storage(out)
+    ours = inverse_dynamics_of_motion(load_model(model_path), read_storage(motion), external_loads=loads, lowpass_hz=6.0)
+    assert np.abs(ours.data - reference.data).max() <= 1e-6

@@ -24,6 +24,7 @@ import numpy as np
 
 from nmsm.core import reductions
 from nmsm.tools.gcp.inputs import FootInputs
+from nmsm.tools.gcp.neighbors import NeighborOperator
 from nmsm.tools.gcp.state import Design
 from nmsm.tools.gcp.values import FootValues
 
@@ -99,13 +100,13 @@ class GcpContext:
 
     def neighbor_deviation(self, foot: int) -> Any:
         """``K_j - sum_k w_jk K_k / sum_k w_jk`` (n, T), ``w_jk = exp(-d_jk^2 / (2 sigma^2))``
-        over the other springs ``k``, ``d`` their 3-D distance in each frame."""
+        over the other springs ``k``, ``d`` their 3-D distance in each frame
+        (:class:`~nmsm.tools.gcp.neighbors.NeighborOperator`)."""
         if foot not in self._neighbor:
-            n = self.feet[foot].springs.n_springs
-            frames = self.feet[foot].n_frames
-            function = neighbor_function(n, self.neighbor_standard_deviation).map(frames, "thread", 2)
-            positions = cs.reshape(self.values[foot].spring_positions, 3 * n, frames)
-            self._neighbor[foot] = function(positions, self.design.spring_constants)
+            f = self.feet[foot]
+            operator = NeighborOperator(f.foot, f.springs, self.neighbor_standard_deviation)
+            self._neighbor[foot] = operator.deviation(self.values[foot].coordinates[0, :],
+                                                      self.design.spring_constants)
         return self._neighbor[foot]
 
     def electrical_center_shift(self, foot: int) -> Any:
@@ -123,16 +124,3 @@ class GcpContext:
     def reduce_constraint(self, term: Any, value: Any) -> tuple[Any, Any, Any]:
         raise term.error("GCP has no constraint terms", expected="cost terms only")
 
-
-def neighbor_function(n_springs: int, sigma: float) -> cs.Function:
-    """SX Function ``(positions 3n x 1 (stacked columns), K n) -> deviation n`` of one frame."""
-    stacked = cs.SX.sym("positions", 3 * n_springs)
-    k = cs.SX.sym("K", n_springs)
-    p = cs.reshape(stacked, 3, n_springs)
-    rows = []
-    for j in range(n_springs):
-        d2 = cs.sum1((p - cs.repmat(p[:, j], 1, n_springs)) ** 2)
-        w = cs.exp(-d2 / (2.0 * sigma**2))
-        w[j] = 0
-        rows.append(k[j] - cs.dot(w, k.T) / cs.sum2(w))
-    return cs.Function("neighbor_deviation", [stacked, k], [cs.vertcat(*rows)])

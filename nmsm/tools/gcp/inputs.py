@@ -13,9 +13,11 @@ Per foot (``T`` frames, ``n`` springs, ``m`` B-spline nodes):
   ``basis @ (base_nodes * C)`` with the multiplicative coefficients ``C`` (m, 7).
 * ``slope_experimental``/``slope_modeled`` (T, T): the degree-2 B-spline derivative
   operators of the slope terms (``m`` nodes for experimental, 25 for modeled curves).
-* ``frame_function``: ``(q 7, qdot 7, K n, parameters 6) -> (markers 3x5, marker
-  velocities 3x5, force 3, moment 3, spring positions 3xn)`` for one frame; the moment is
-  about the modeled midfoot-superior marker projected on the floor.
+* ``frame_function``: ``(q 7, qdot 7, parameters 6) -> (markers 3x5, marker velocities
+  3x5, loads_per_k 6xn, loads_offset 6x1, spring positions 3xn)`` for one frame: the
+  ground reaction and its moment about the modeled midfoot-superior marker projected on
+  the floor are ``loads_per_k @ K + loads_offset``
+  (:func:`~nmsm.model.foot_contact.unit_loads`).
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from nmsm.io.settings.gcp import ContactSurfaceSettings, GroundContactPersonaliz
 from nmsm.io.storage import Table
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.components import Model
-from nmsm.model.foot_contact import contact_function
+from nmsm.model.foot_contact import unit_loads
 from nmsm.tools.gcp import bspline
 from nmsm.tools.gcp.data import (GroundReactions, foot_ground_reactions, full_coordinates, window_indices)
 from nmsm.tools.gcp.foot_model import FootMarkers, FootModel, foot_coordinates, unwrap_angles
@@ -93,21 +95,19 @@ def foot_markers(surface: ContactSurfaceSettings) -> FootMarkers:
 
 def build_frame_function(foot: FootModel, springs: SpringLayout) -> cs.Function:
     """The per-frame function described in the module docstring."""
-    n = springs.n_springs
     q, qdot = foot.q, foot.qdot
     marker_positions = foot.point_positions(foot.marker_points)
     marker_velocities = foot.point_velocities(marker_positions)
     spring_positions = foot.point_positions(springs.points())
     spring_velocities = foot.point_velocities(spring_positions)
-    k = cs.SX.sym("K", n)
     parameters = cs.SX.sym("parameters", 6)
     midfoot = marker_positions[:, 4]
     reference = cs.vertcat(midfoot[0], 0, midfoot[2])
-    force, moment, _ = contact_function(n)(spring_positions, spring_velocities, k, parameters, reference)
-    return cs.Function("gcp_frame", [q, qdot, k, parameters],
-                       [marker_positions, marker_velocities, force, moment, spring_positions],
-                       ["q", "qdot", "K", "parameters"],
-                       ["markers", "marker_velocities", "force", "moment", "spring_positions"])
+    per_k, offset = unit_loads(spring_positions, spring_velocities, parameters, reference)
+    return cs.Function("gcp_frame", [q, qdot, parameters],
+                       [marker_positions, marker_velocities, per_k, offset, spring_positions],
+                       ["q", "qdot", "parameters"],
+                       ["markers", "marker_velocities", "loads_per_k", "loads_offset", "spring_positions"])
 
 
 def experimental_foot_coordinates(casadi_model: CasadiModel, q_full: np.ndarray, foot: FootModel) -> np.ndarray:

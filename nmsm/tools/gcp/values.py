@@ -22,6 +22,7 @@ from typing import Any
 import attrs
 import casadi as cs
 import numpy as np
+import scipy.sparse
 
 from nmsm.tools.gcp.inputs import FootInputs
 from nmsm.tools.gcp.state import Design
@@ -73,15 +74,25 @@ def experimental_reactions(foot: FootInputs, resting_length: Any, shift: Any, th
 def foot_values(foot: FootInputs, design: Design, index: int) -> FootValues:
     """The :class:`FootValues` of ``foot`` (position ``index`` in the design's foot lists)."""
     nodes = cs.DM(foot.base_nodes) * design.coefficients[index]
-    q = cs.mtimes(cs.DM(foot.basis), nodes).T
-    qdot = cs.mtimes(cs.DM(foot.basis_rate), nodes).T
+    q = cs.mtimes(sparse_dm(foot.basis), nodes).T
+    qdot = cs.mtimes(sparse_dm(foot.basis_rate), nodes).T
     frames = foot.n_frames
     mapped = foot.frame_function.map(frames, "thread", MAP_THREADS)
     parameters = design.contact_parameters(foot.surface.belt_speed)
-    markers, velocities, forces, moments, springs = mapped(q, qdot, design.spring_constants, parameters)
+    markers, velocities, per_k, offset, springs = mapped(q, qdot, parameters)
+    n = foot.springs.n_springs
+    loads = cs.mtimes(cs.kron(cs.reshape(design.spring_constants, 1, n), cs.DM.eye(6)),
+                      cs.reshape(per_k, 6 * n, frames)) + offset
+    forces, moments = loads[0:3, :], loads[3:6, :]
     exp_forces, exp_moments = experimental_reactions(
         foot, design.resting_spring_length, design.electrical_center_shifts[index], design.plate_rotations[index])
     return FootValues(q, qdot, markers, velocities, forces, moments, springs, exp_forces, exp_moments)
+
+
+def sparse_dm(matrix: np.ndarray) -> cs.DM:
+    """A DM keeping only the nonzero entries of ``matrix`` (structural sparsity for
+    Jacobians; a dense DM makes every entry a dependency)."""
+    return cs.DM(scipy.sparse.csc_matrix(np.asarray(matrix, dtype=float)))
 
 
 def as_array(value: Any) -> np.ndarray:

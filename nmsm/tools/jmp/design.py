@@ -102,7 +102,12 @@ def check_names(model: Model, task: JmpTask, marker_file_names: Sequence[str], s
     """Every joint, body and marker the task names exists (in the model; markers also in the
     marker file), else :class:`InputError` naming the settings file and element."""
     joints = [j.name for j in model.joints]
+    seen: set[str] = set()
     for joint in task.joints:
+        if joint.name in seen:
+            raise _error(task, settings_file, f"joint '{joint.name}' is listed twice", f'<JMPJoint name="{joint.name}">',
+                         "each joint once per task (flag all its parameters in one <JMPJoint>)", joint.source.line)
+        seen.add(joint.name)
         if joint.name not in joints:
             close = close_matches(joint.name, joints)
             raise _error(task, settings_file, f"joint '{joint.name}' is not in the model {model.file}"

@@ -288,6 +288,9 @@ def run_ik_files(model_file: str | os.PathLike[str], marker_file: str | os.PathL
         marker_file = settings.marker_file
     if output is None and settings is not None:
         output = settings.output_motion_file
+    if settings is not None and np.isfinite(settings.constraint_weight):
+        warnings.warn(f"{settings.file}: <constraint_weight> {settings.constraint_weight:g} ignored: nmsm always "
+                      "enforces coordinate couplers exactly (OpenSim's Inf)", stacklevel=2)
     result = inverse_kinematics(
         model_file, marker_file,
         weights=settings.marker_weights if settings else None,

@@ -121,8 +121,8 @@ class BlockArrowJacobian:
     ``dq`` ``(F, m, n)`` = dr_f/dq_f; ``dp`` ``(F, m, k)`` = dr_f/dp.
     """
 
-    dq: np.ndarray
-    dp: np.ndarray
+    dq: np.ndarray = attrs.field(converter=np.ascontiguousarray)
+    dp: np.ndarray = attrs.field(converter=np.ascontiguousarray)
 
     @property
     def shape(self) -> tuple[int, int, int, int]:
@@ -142,12 +142,14 @@ class BlockArrowJacobian:
         f, m, n, k = self.shape
         free_q = free[: f * n].reshape(f, n).astype(float)
         free_p = free[f * n:].astype(float)
+        # stacked small products (one per frame): BLAS stays single-threaded at these sizes,
+        # which is much faster than one large threaded product on a busy machine
         dq = self.dq * free_q[:, None, :]
         dp = self.dp * free_p[None, None, :]
         dq_t = dq.transpose(0, 2, 1)
         a = dq_t @ dq
         b = dq_t @ dp
-        c = np.tensordot(dp, dp, axes=([0, 1], [0, 1]))
+        c = (dp.transpose(0, 2, 1) @ dp).sum(axis=0)
         dq_diag = (mu * diag[: f * n].reshape(f, n)) * free_q + (1.0 - free_q)
         a[:, np.arange(n), np.arange(n)] += dq_diag
         c[np.arange(k), np.arange(k)] += mu * diag[f * n:] * free_p + (1.0 - free_p)
@@ -157,8 +159,9 @@ class BlockArrowJacobian:
             return -np.linalg.solve(a, gq[:, :, None])[:, :, 0].ravel()
         solved = np.linalg.solve(a, np.concatenate([b, gq[:, :, None]], axis=2))
         x_b, y = solved[:, :, :k], solved[:, :, k]
-        schur = c - np.tensordot(b, x_b, axes=([0, 1], [0, 1]))
-        rhs = -gp + np.tensordot(b, y, axes=([0, 1], [0, 1]))
+        b_t = b.transpose(0, 2, 1)
+        schur = c - (b_t @ x_b).sum(axis=0)
+        rhs = -gp + (b_t @ y[:, :, None]).sum(axis=0)[:, 0]
         step_p = np.linalg.solve(schur, rhs)
         step_q = -(y + x_b @ step_p)
         return np.concatenate([step_q.ravel(), step_p]) * free

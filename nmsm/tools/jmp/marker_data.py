@@ -13,7 +13,7 @@ gap, so that marker is dropped from that frame, as OpenSim does.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import attrs
 import numpy as np
@@ -166,7 +166,3 @@ def check_units(trial: MarkerTrial, model_positions: np.ndarray) -> tuple[Marker
 
 #: power of ten applied -> (unit the numbers are in, unit the header claims), e.g. -3: mm read as m
 _UNIT_NAMES = {-3: ("mm", "m"), -2: ("cm", "m"), -1: ("mm", "cm"), 1: ("cm", "mm"), 2: ("m", "cm"), 3: ("m", "mm")}
-
-
-def weight_map(names: Sequence[str], weights: Sequence[float]) -> dict[str, float]:
-    return {n: float(w) for n, w in zip(names, weights)}

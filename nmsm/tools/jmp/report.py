@@ -92,11 +92,14 @@ def format_task(title: str, rows: Sequence[ErrorRow], variables: Sequence[Design
                      f"{1000 * row.rms_after:>10.3f} {1000 * row.max_before:>11.3f} {1000 * row.max_after:>10.3f}")
     lines += ["", "Parameters (m, rad; scale factors relative to the task's input model)",
               f"  {'parameter':<48s} {'initial':>12s} {'final':>12s} {'change':>14s} {'bounds':>27s}"]
+    any_at_bound = False
     for variable, a, b in zip(variables, initial, final):
-        at_bound = " *" if np.isclose(b, variable.lower, atol=1e-9) or np.isclose(b, variable.upper, atol=1e-9) else ""
+        at_bound = bool(np.isclose(b, variable.lower, atol=1e-9) or np.isclose(b, variable.upper, atol=1e-9))
+        any_at_bound |= at_bound
         lines.append(f"  {variable.label:<48s} {a:>12.6f} {b:>12.6f} {_change(variable, a, b):>14s} "
-                     f"[{variable.lower:>11.5g}, {variable.upper:>11.5g}]{at_bound}")
-    lines += ["  (* at a bound)", "",
+                     f"[{variable.lower:>11.5g}, {variable.upper:>11.5g}]{' *' if at_bound else ''}")
+    lines += ["  (* at a bound)"] if any_at_bound else []
+    lines += ["",
               f"Solver: {solver['status']}; {solver['iterations']} iterations, {solver['evaluations']} evaluations, "
               f"{solver['wall_time']:.2f} s; cost {solver['initial_cost']:.6g} -> {solver['cost']:.6g}"]
     lines += [f"Note: {n}" for n in notes]

@@ -140,8 +140,10 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
     inputs = [settings.input_model_file, settings.settings_file, *[t.marker_file_name for t in settings.tasks]]
     try:
         results = ResultsDirectory(out_dir, inputs=inputs)
+        if not os.access(results.path, os.W_OK):
+            raise PermissionError(13, "not writable")
     except OSError as exc:
-        raise InputError(f"cannot create the results folder {out_dir} ({exc.strerror or exc})",
+        raise InputError(f"cannot write into the results folder {out_dir} ({exc.strerror or exc})",
                          file=settings.settings_file, element="<results_directory>",
                          expected="a writable folder (pass results_directory= to write elsewhere)") from exc
     log_lines: list[str] = []

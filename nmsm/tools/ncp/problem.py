@@ -21,7 +21,8 @@ own entry (``proximal:start_activations``) and never counted in NCP's cost. Use 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import attrs
@@ -30,7 +31,7 @@ import numpy as np
 
 from nmsm.constraints.ncp.synergy_weight_sum import SynergyWeightSum
 from nmsm.core.problem import OptimizationProblem, Solution
-from nmsm.core.term import Term
+from nmsm.core.term import CostTerm, Term
 from nmsm.tools.ncp.context import NcpContext
 from nmsm.tools.ncp.initial_guess import SynergyGuess
 from nmsm.tools.ncp.inputs import NcpInputs
@@ -62,6 +63,28 @@ class NcpProblem:
     context: NcpContext
     weight_variables: list[str]
     node_variables: list[str]
+    #: every cost entry as (weight, residual builder taking an NcpContext), for the structured Hessian
+    cost_builders: list[tuple[float, Callable[[NcpContext], Any]]] = attrs.field(factory=list)
+    _hessian: Any = attrs.field(default=None, init=False)
+
+    def ipopt_options(self) -> dict[str, Any]:
+        """Back-end options giving IPOPT the structured exact Hessian (:mod:`nmsm.tools.ncp.hessian`).
+
+        Empty when the terms do not have the affine frame-local form (CasADi's automatic
+        Hessian is used then, much slower to build for large models).
+        """
+        from nmsm.tools.ncp.hessian import hessian_function
+
+        function = hessian_function(self.problem, self.inputs, self.cost_builders, self.weight_variables, self.node_variables)
+        if function is None:
+            warnings.warn(
+                "NCP: a cost term is not affine in the activations frame by frame; using CasADi's automatic "
+                "Hessian (slow to build for large models)",
+                stacklevel=2,
+            )
+            return {}
+        self._hessian = function  # the callback must outlive the solver
+        return {"casadi_options": {"hess_lag": function}}
 
     def solution(self, solved: Solution) -> SynergySolution:
         """The synergies (not normalized) at a solved point."""
@@ -114,20 +137,25 @@ def build_problem(
         node_names.append(var)
         activations.append(synergy_activations(weights, layout.commands(nodes, trial.n_points)))
     context = NcpContext(inputs, weight_blocks, activations)
+    builders: list[tuple[float, Callable[[NcpContext], Any]]] = []
     for term in terms:
         problem.add_term(term, context)
+        if isinstance(term, CostTerm):
+            builders.append((1.0, term.residuals))
     if proximal_weight > 0:
         start_weights = layout.weight_matrix(list(guess.weight_blocks))
-        deviations = []
-        for t, trial in enumerate(inputs.trials):
-            start = layout.commands(guess.nodes[t], trial.n_points) @ start_weights
-            deviations.append(cs.vec(activations[t] - cs.DM(start)))
-        stacked = cs.vertcat(*deviations)
-        problem.add_cost(PROXIMAL_ENTRY, stacked / np.sqrt(stacked.numel()), weight=proximal_weight)
+        starts = [layout.commands(guess.nodes[t], trial.n_points) @ start_weights for t, trial in enumerate(inputs.trials)]
+
+        def proximal(ctx: NcpContext, starts: list[np.ndarray] = starts) -> Any:
+            stacked = cs.vertcat(*[cs.vec(a - cs.DM(s0)) for a, s0 in zip(ctx.activations, starts)])
+            return stacked / np.sqrt(stacked.numel())
+
+        problem.add_cost(PROXIMAL_ENTRY, proximal(context), weight=proximal_weight)
+        builders.append((proximal_weight, proximal))
     for group in layout.free_groups:
         g = layout.groups[group]
         problem.add_term(SynergyWeightSum(group=group, target=g.weight_sum, name=g.name), context)
-    return NcpProblem(inputs, problem, context, weight_names, node_names)
+    return NcpProblem(inputs, problem, context, weight_names, node_names, builders)
 
 
 def score(inputs: NcpInputs, terms: Sequence[Term], solution: SynergySolution) -> dict[str, float]:

@@ -77,7 +77,8 @@ def solve(setup: NcpSetup, **ipopt_options: Any) -> tuple[SynergySolution, Solut
     """Optimize the synergies of ``setup``; returns the (not normalized) solution and the solver result."""
     guess = initial_guess(setup.inputs)
     built = build_problem(setup.inputs, setup.terms, guess)
-    solved = built.problem.solve("ipopt", **ipopt_options)
+    options = {**built.ipopt_options(), **ipopt_options}
+    solved = built.problem.solve("ipopt", **options)
     if not solved.success and "Maximum_Iterations" not in solved.status and "Acceptable" not in solved.status:
         raise SolverError(f"NCP optimization failed: IPOPT status {solved.status} after {solved.iterations} iterations")
     return built.solution(solved), solved

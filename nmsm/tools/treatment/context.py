@@ -172,6 +172,14 @@ class GridView:
     def normalized_fiber_length(self, muscle: str) -> cs.MX:
         return self._q.muscle_quantity(self.grid, "normalized_fiber_length")[:, self._q.muscle_index(muscle)]
 
+    def map_kinematics_function(self, key: Any, function: cs.Function, uses: str = "q, qd, qdd",
+                                coordinates: Any = None, extra: tuple = ()) -> list[cs.MX]:
+        """Evaluate a per-point SX ``function(q, qd, qdd subset..., *extra)`` on this grid,
+        composed with the kinematics so its derivatives only span the decision variables
+        (faster than mapping over :meth:`positions` columns). ``extra``: (n, k) or (1, k)."""
+        composed = self._q.composed(key, function, uses, coordinates)
+        return self._q.map_point(composed, self.grid, *extra)
+
     # ---- generic caching for extensions -------------------------------------------------------
     def cached(self, key: str, compute: Callable[[GridView], cs.MX]) -> cs.MX:
         """``compute(self)`` once per grid and ``key`` (for quantities added by plugins)."""
@@ -498,23 +506,32 @@ class _Quantities:
             return cs.Function("full_kinematics", [v, c, ratio], [q, qd, qdd])
         return self.cache(("full_kinematics_function",), compute)
 
-    def composed(self, key: Any, function: cs.Function, uses: str = "q, qd, qdd") -> cs.Function:
-        """``function`` of full kinematics turned into an SX point function of
-        ``(v, c, ratio)`` (see :meth:`_point_inputs`), so derivatives only span the
-        variables. ``uses``: which of q, qd, qdd ``function`` takes, in that order."""
+    def composed(self, key: Any, function: cs.Function, uses: str = "q, qd, qdd",
+                 coordinates: Any = None) -> cs.Function:
+        """``function`` of the kinematics turned into an SX point function of
+        ``(v, c, ratio, *extra)`` (see :meth:`_point_inputs`), so derivatives only span the
+        variables. ``uses``: which of q, qd, qdd ``function`` takes first, in that order;
+        ``coordinates``: pass only these coordinates' entries (default: all); the
+        function's remaining inputs become the ``extra`` inputs, passed through."""
         def compute() -> cs.Function:
             full = self._full_kinematics_function()
             v, c, ratio = (cs.SX.sym(n, full.size1_in(i)) for i, n in enumerate(("v", "c", "ratio")))
             q, qd, qdd = full(v, c, ratio)
+            if coordinates is not None:
+                idx = [self.coordinate_index(name) for name in coordinates]
+                q, qd, qdd = (cs.vertcat(*[x[i] for i in idx]) for x in (q, qd, qdd))
             args = {"q": q, "qd": qd, "qdd": qdd}
-            outs = function.call([args[k.strip()] for k in uses.split(",")])
-            return cs.Function(f"point_{function.name()}", [v, c, ratio], outs)
+            used = [args[k.strip()] for k in uses.split(",")]
+            extra = [cs.SX.sym(function.name_in(i), function.sparsity_in(i)) for i in range(len(used), function.n_in())]
+            outs = function.call(used + extra)
+            return cs.Function(f"point_{function.name()}", [v, c, ratio, *extra], outs)
         return self.cache(("composed", key), compute)
 
-    def map_point(self, function: cs.Function, grid: str) -> list[cs.MX]:
-        """Evaluate an SX point function of ``(v, c, ratio)`` on every row of ``grid``."""
+    def map_point(self, function: cs.Function, grid: str, *extra: Any) -> list[cs.MX]:
+        """Evaluate an SX point function of ``(v, c, ratio, *extra)`` on every row of
+        ``grid``; each ``extra`` is (n, k) or (1, k) (broadcast)."""
         V, C, ratio = self._point_inputs(grid)
-        return map_rows(function, V, C, cs.MX(ratio) if not isinstance(ratio, float) else cs.DM(ratio),
+        return map_rows(function, V, C, cs.MX(ratio) if not isinstance(ratio, float) else cs.DM(ratio), *extra,
                         parallel=self.parallel)
 
     def tracked_kinematics(self, grid: str, order: int) -> cs.DM:

@@ -139,6 +139,9 @@ class MuscleModel:
 
     def evaluate(self, view: Any, activations: cs.MX, parallel: int = 1) -> list[cs.MX]:
         """[forces (n, M), moments (n, n_c), l̃ (n, M), ṽ (n, M)] on a grid view."""
+        if hasattr(view, "map_kinematics_function"):
+            return view.map_kinematics_function(("muscles", id(self)), self.point_function(), "q, qd",
+                                                self.coordinates, (activations, self.parameter_row()))
         Q = cs.horzcat(*[view.coordinate(c) for c in self.coordinates])
         Qd = cs.horzcat(*[view.speed(c) for c in self.coordinates])
         return map_rows(self.point_function(), Q, Qd, activations, self.parameter_row(), parallel=parallel)
