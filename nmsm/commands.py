@@ -9,7 +9,10 @@ from typing import Any
 def _run(args: argparse.Namespace) -> int:
     from nmsm.tools.dispatch import run_settings_file
 
-    run_settings_file(args.settings)
+    options = {}
+    if args.results_directory:
+        options["results_directory"] = args.results_directory
+    run_settings_file(args.settings, **options)
     return 0
 
 
@@ -28,6 +31,10 @@ def _plugins(args: argparse.Namespace) -> int:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser("run", help="run the tool named by a settings XML file")
     p.add_argument("settings", help="settings XML (root NMSMPipelineDocument, or an older schema)")
+    p.add_argument(
+        "-o", "--results-directory",
+        help="write results here instead of the settings' <results_directory> (e.g. to keep a tutorial folder untouched)",
+    )
     p.set_defaults(func=_run)
 
     p = subparsers.add_parser("plugins", help="list every registered term, constraint, controller and modifier")

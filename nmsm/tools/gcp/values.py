@@ -29,6 +29,8 @@ from nmsm.tools.gcp.state import Design
 
 #: worker threads of the per-frame map
 MAP_THREADS = 2
+#: options of the per-frame map (see nmsm.tools.gcp.values)
+MAP_OPTIONS: dict = {}
 
 
 @attrs.frozen(eq=False)
@@ -77,7 +79,7 @@ def foot_values(foot: FootInputs, design: Design, index: int) -> FootValues:
     q = cs.mtimes(sparse_dm(foot.basis), nodes).T
     qdot = cs.mtimes(sparse_dm(foot.basis_rate), nodes).T
     frames = foot.n_frames
-    mapped = foot.frame_function.map(frames, "thread", MAP_THREADS)
+    mapped = foot.frame_function.map("frames", "thread", frames, [], [], MAP_OPTIONS)
     parameters = design.contact_parameters(foot.surface.belt_speed)
     markers, velocities, per_k, offset, springs = mapped(q, qdot, parameters)
     n = foot.springs.n_springs

@@ -58,8 +58,9 @@ class DesignVariable:
 @attrs.frozen(eq=False)
 class TaskDesign:
     """Design of one task: ``parameters`` (CasADi symbols, in :attr:`variables` order),
-    ``variables``, ``marker_names`` used, ``unscaled_marker_bodies`` (scaled bodies whose
-    markers stay put) and ``scale_mass`` (JMP scales like ``Model.scale(preserveMassDist=true)``)."""
+    ``variables``, ``marker_names`` used and ``unscaled_marker_bodies`` (scaled bodies whose
+    markers stay put). Scaled bodies keep their mass, their inertia scales by ``s**2``
+    (``Model.scale(preserveMassDist=true)`` as the original calls it)."""
 
     parameters: ModelParameters
     variables: tuple[DesignVariable, ...]
@@ -157,7 +158,7 @@ def build_design(model: Model, task: JmpTask, marker_file_names: Sequence[str], 
                      "<marker_names>", "markers on the task's joints' bodies, or an explicit <marker_names>")
     bounded = _has_bounds(task)
     params = ModelParameters(model)
-    params.scale_mass = True
+    params.scale_mass = False  # Model.scale(..., preserveMassDist=true): mass kept, inertia * s**2
     variables: list[DesignVariable] = []
 
     def frame_variables(joint_name: str, which: str, frame: JmpFrame) -> None:

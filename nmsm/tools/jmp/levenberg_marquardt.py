@@ -16,7 +16,7 @@ Convergence (any of):
 
 * ``|step|_inf <= xtol * (xtol + |x|_inf)``                          (step)
 * ``cost - new_cost <= ftol * cost``  for an accepted step           (function)
-* ``|projected gradient|_inf <= gtol``                               (first order)
+* ``|projected J^T r|_inf <= gtol``                                 (first order)
 * ``cost <= ctol``                                                   (exact fit)
 
 The linear algebra is pluggable: ``fun(x)`` returns ``(r, J)`` with ``J`` one of

@@ -21,11 +21,11 @@ through :class:`~nmsm.core.results.ResultsDirectory`, task by task, never over a
 
 Optimizer options of the settings are honoured: ``function_tolerance`` (relative cost
 change), ``step_tolerance`` (step relative to the variables), ``optimality_tolerance``
-(infinity norm of the projected gradient of the normalized cost), ``max_function_evaluations``
-(residual and exact-Jacobian evaluations) and ``accuracy`` (the IK before/after, see
-:func:`~nmsm.tools.jmp.ik.tolerances_for_accuracy`). ``diff_min_change`` is the minimum
-finite-difference step of the original's solver; nmsm differentiates exactly, so it has no
-counterpart (the report says so).
+(infinity norm of the projected ``J^T r``, half the gradient of the normalized cost),
+``max_function_evaluations`` (residual and exact-Jacobian evaluations) and ``accuracy``
+(the IK before/after, see :func:`~nmsm.tools.jmp.ik.tolerances_for_accuracy`).
+``diff_min_change`` is the minimum finite-difference step of the original's solver; nmsm
+differentiates exactly, so it has no counterpart (the log says so).
 """
 
 from __future__ import annotations

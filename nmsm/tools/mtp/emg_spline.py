@@ -76,12 +76,16 @@ def evaluate_pp(breaks: np.ndarray, coefs: np.ndarray, t: np.ndarray) -> np.ndar
 
 
 def _candidate_pieces(breaks: np.ndarray, t: float, max_delay: float) -> list[int]:
-    """Pieces that ``t - d`` can fall into for ``d`` in ``[0, max_delay]`` (one spare each side)."""
+    """Pieces that ``t - d`` can fall into for ``d`` in ``[0, max_delay]``.
+
+    Outside that range the nearest candidate's polynomial is used; the spline is C2, so at
+    the range ends (``d`` on a bound) the result is exact up to rounding.
+    """
     n_pieces = breaks.size - 1
     lo = np.searchsorted(breaks, t - max_delay, side="right") - 1
     hi = np.searchsorted(breaks, t, side="right") - 1
-    lo = int(np.clip(lo - 1, 0, n_pieces - 1))
-    hi = int(np.clip(hi + 1, 0, n_pieces - 1))
+    lo = int(np.clip(lo, 0, n_pieces - 1))
+    hi = int(np.clip(hi, 0, n_pieces - 1))
     return list(range(lo, hi + 1))
 
 

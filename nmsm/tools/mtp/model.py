@@ -8,17 +8,19 @@ Chain per trial and muscle (tools.md §4.2, Meyer 2017):
    negatives set to 0;
 3. activation nonlinearity ``A``;
 4. normalized fiber length/velocity with scaled ``l_o``, ``l_ts``; tendon force and passive
-   force (:mod:`nmsm.model.hill`).
+   force (:mod:`nmsm.model.hill`); joint moments ``sum_m r F``.
 
-Two SX functions per trial evaluate the chain for one muscle and are ``map``-ped over the
-muscles: excitation -> activation (depends on the activation parameters and, with SynX,
-synergy weights) and activation -> forces (depends on the length scale factors); the
-joint moments are MX sums. Keeping the two apart lets a problem *lift* the activations
-(decision variables constrained to the modeled ones), which keeps exact Jacobians and
-Hessians sparse. Design quantities enter in their MTP units:
-electromechanical delay in 0.1 s, activation time constant in 0.01 s.
+Two SX functions per trial are ``map``-ped over the muscles: excitation -> activation
+(activation parameters; with SynX also synergy weights enter through the excitation
+samples) and (activation, normalized length, normalized velocity) -> tendon force.
+Normalized lengths, velocities and passive forces are plain MX elementwise expressions of
+the length scale factors. A problem may *lift* activations, lengths, velocities and
+moments (decision variables constrained to the modeled values,
+:func:`nmsm.tools.mtp.problem.build_task_problem`) so that exact Jacobians and Hessians
+stay sparse. Design quantities enter in their MTP units: electromechanical delay in
+0.1 s, activation time constant in 0.01 s.
 
-Shapes of :class:`TrialModel` outputs: excitations ``(n_emg, n_muscles)``, the rest
+Shapes of :class:`TrialModel` fields: excitations ``(n_emg, n_muscles)``, the rest
 ``(n_frames, n_muscles)``, moments ``(n_frames, n_coordinates)``.
 """
 
@@ -69,17 +71,22 @@ class MuscleDesign:
         )
 
 
-def _row(value: Any, n: int) -> cs.MX:
+def row(value: Any, n: int) -> cs.MX:
     """A ``1 x n`` MX row from numpy (n,) or a CasADi vector/row."""
     if isinstance(value, (cs.MX, cs.SX, cs.DM)):
-        v = cs.MX(value) if not isinstance(value, cs.MX) else value
+        v = value if isinstance(value, cs.MX) else cs.MX(value)
         return cs.reshape(v, 1, n)
     return cs.MX(cs.DM(np.asarray(value, dtype=float).reshape(1, n)))
 
 
 @attrs.frozen(eq=False)
 class TrialModel:
-    """Modeled quantities of one trial (CasADi MX)."""
+    """Modeled quantities of one trial (CasADi MX).
+
+    ``activations`` / ``moments`` are what forces and costs use (lifted variables in an
+    optimization); ``modeled_activations`` / ``modeled_moments`` the model's values of
+    the same quantities.
+    """
 
     name: str
     excitations: cs.MX
@@ -91,17 +98,18 @@ class TrialModel:
     tendon_force: cs.MX
     passive_force: cs.MX
     moments: cs.MX
-    modeled_activations: cs.MX | None = None
+    modeled_activations: cs.MX
+    modeled_moments: cs.MX
 
 
 class TrialChain:
-    """Builds the per-muscle SX chain of one trial (sample times, spline pieces, padding).
+    """Builds the per-muscle SX functions of one trial (sample times, spline pieces, padding).
 
-    ``stride``: the EMG spline goes through every ``stride``-th sample (MATLAB's
-    Synergy Extrapolation path uses 4; its plain path 1 with current sources).
+    ``stride``: the EMG spline goes through every ``stride``-th EMG sample (the original's
+    Synergy Extrapolation path uses 4; see :class:`nmsm.tools.mtp.problem.MtpData`).
     """
 
-    def __init__(self, trial: TrialData, *, stride: int = 1, max_delay_variable: float = MAX_DELAY_VARIABLE) -> None:
+    def __init__(self, trial: TrialData, *, stride: int = 4, max_delay_variable: float = MAX_DELAY_VARIABLE) -> None:
         if trial.emg_time is None:
             raise ValueError(f"trial '{trial.name}' has no EMG")
         self.trial = trial
@@ -116,10 +124,6 @@ class TrialChain:
         self.max_delay = max_delay_variable / 10.0
         self.activation_function, self.force_function = self._build()
 
-    @property
-    def n_coefficients(self) -> int:
-        return self.spline_matrix.shape[0]
-
     def _build(self) -> tuple[cs.Function, cs.Function]:
         n = self.trial.n_frames
         sampler = emg_spline.delayed_sampler(self.breaks, self.sample_times, self.max_delay, "emg_delay")
@@ -127,7 +131,7 @@ class TrialChain:
         delay = cs.SX.sym("delay")  # 0.1 s
         tau = cs.SX.sym("tau")  # 0.01 s
         nonlin = cs.SX.sym("A")
-        coefs = cs.SX.sym("coefs", self.n_coefficients)
+        coefs = cs.SX.sym("coefs", self.spline_matrix.shape[0])
         e = sampler(delay / 10.0, coefs)
         neural_all = dynamics(e, tau / 100.0, self.dt)
         pad = self.padding
@@ -141,81 +145,98 @@ class TrialChain:
             ["e", "n", "a"],
         )
         a = cs.SX.sym("a", n)
-        lmt = cs.SX.sym("lmt", n)
-        vmt = cs.SX.sym("vmt", n)
-        lo = cs.SX.sym("lo")
-        lts = cs.SX.sym("lts")
+        lnorm = cs.SX.sym("l", n)
+        vnorm = cs.SX.sym("v", n)
         alpha = cs.SX.sym("alpha")
         f0 = cs.SX.sym("F0")
-        vmax = cs.SX.sym("vmax")
-        lnorm = hill.normalized_fiber_length(lmt, lo, lts, alpha)
-        vnorm = hill.normalized_fiber_velocity(vmt, lo, alpha, vmax)
         force = cs.Function(
             f"mtp_force_{self.trial.name}",
-            [a, lmt, vmt, lo, lts, alpha, f0, vmax],
-            [lnorm, vnorm, hill.tendon_force(a, lnorm, vnorm, f0, alpha), hill.passive_tendon_force(lnorm, f0, alpha)],
-            ["a", "lmt", "vmt", "lo", "lts", "alpha", "F0", "vmax"],
-            ["l", "v", "F", "Fp"],
+            [a, lnorm, vnorm, f0, alpha],
+            [hill.tendon_force(a, lnorm, vnorm, f0, alpha)],
+            ["a", "l", "v", "F0", "alpha"],
+            ["F"],
         )
         return activation, force
 
-    def emg_coefficients(self, emg: np.ndarray) -> np.ndarray:
-        """Spline coefficients (4 P, k) of EMG samples (n_emg, k)."""
-        return self.spline_matrix @ np.asarray(emg, dtype=float)
-
-    def activations(self, design: MuscleDesign, excitation_samples: cs.MX) -> tuple[cs.MX, cs.MX, cs.MX]:
+    def activations(self, design: MuscleDesign, excitation_samples: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
         """``(excitations (n_emg, M), neural activations (n, M), activations (n, M))``."""
         m = int(excitation_samples.shape[1])
         coefs = cs.mtimes(cs.DM(self.spline_matrix), excitation_samples)
         e, neural, act = self.activation_function.map(m)(
-            _row(design.electromechanical_delay, m),
-            _row(design.activation_time_constant, m),
-            _row(design.activation_nonlinearity, m),
+            row(design.electromechanical_delay, m),
+            row(design.activation_time_constant, m),
+            row(design.activation_nonlinearity, m),
             coefs,
         )
         return e, neural, act
 
-    def forces(
-        self, muscles: MuscleParameters, design: MuscleDesign, activations: cs.MX, vmax_factor: float
-    ) -> tuple[cs.MX, cs.MX, cs.MX, cs.MX, cs.MX]:
-        """``(normalized length, normalized velocity, tendon force, passive force, moments)``."""
+    def fiber_kinematics(self, muscles: MuscleParameters, design: MuscleDesign, vmax_factor: float) -> tuple[cs.MX, cs.MX]:
+        """Normalized fiber lengths and velocities ``(n, M)`` as MX of the scale factors."""
         m = muscles.n_muscles
-        lo = cs.DM(muscles.optimal_fiber_length.reshape(1, m)) * _row(design.optimal_fiber_length_scale, m)
-        lts = cs.DM(muscles.tendon_slack_length.reshape(1, m)) * _row(design.tendon_slack_length_scale, m)
-        lnorm, vnorm, force, passive = self.force_function.map(m)(
+        n = self.trial.n_frames
+        lo = cs.repmat(cs.DM(muscles.optimal_fiber_length.reshape(1, m)) * row(design.optimal_fiber_length_scale, m), n, 1)
+        lts = cs.repmat(cs.DM(muscles.tendon_slack_length.reshape(1, m)) * row(design.tendon_slack_length_scale, m), n, 1)
+        cos_alpha = cs.DM(np.repeat(np.cos(muscles.pennation_angle).reshape(1, m), n, axis=0))
+        lnorm = (cs.DM(self.trial.muscle_tendon_length) - lts) / (lo * cos_alpha)
+        vnorm = cs.DM(self.trial.muscle_tendon_velocity) / (float(vmax_factor) * lo * cos_alpha)
+        return lnorm, vnorm
+
+    def tendon_forces(self, muscles: MuscleParameters, activations: Any, lnorm: Any, vnorm: Any) -> cs.MX:
+        """Tendon forces ``(n, M)`` (N)."""
+        m = muscles.n_muscles
+        return self.force_function.map(m)(
             activations,
-            cs.DM(self.trial.muscle_tendon_length),
-            cs.DM(self.trial.muscle_tendon_velocity),
-            lo,
-            lts,
-            cs.DM(muscles.pennation_angle.reshape(1, m)),
+            lnorm,
+            vnorm,
             cs.DM(muscles.max_isometric_force.reshape(1, m)),
-            cs.DM(np.full((1, m), float(vmax_factor))),
+            cs.DM(muscles.pennation_angle.reshape(1, m)),
         )
-        return lnorm, vnorm, force, passive, joint_moments(self.trial.moment_arms, force)
+
+    def passive_forces(self, muscles: MuscleParameters, lnorm: Any) -> cs.MX:
+        """Passive tendon forces ``F0 f_P(l) cos alpha`` ``(n, M)`` (N), elementwise MX."""
+        m = muscles.n_muscles
+        n = self.trial.n_frames
+        scale = cs.DM(np.repeat((muscles.max_isometric_force * np.cos(muscles.pennation_angle)).reshape(1, m), n, axis=0))
+        return scale * hill.passive_force_length(lnorm)
 
     def evaluate(
         self,
         muscles: MuscleParameters,
         design: MuscleDesign,
-        excitation_samples: cs.MX,
+        excitation_samples: Any,
         vmax_factor: float,
         *,
-        activations: cs.MX | None = None,
+        lifted: dict[str, Any] | None = None,
     ) -> TrialModel:
-        """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)`` (MX).
+        """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)``.
 
-        ``activations``: use these (e.g. lifted decision variables, constrained elsewhere
-        to equal the modeled activations) for forces and moments instead of the modeled ones.
+        ``lifted``: optional ``activations``, ``lengths``, ``velocities``, ``moments``
+        (decision variables constrained elsewhere to the modeled values) used in place of
+        the modeled ones downstream.
         """
+        lifted = lifted or {}
         e, neural, act = self.activations(design, excitation_samples)
-        used = act if activations is None else activations
-        lnorm, vnorm, force, passive, moments = self.forces(muscles, design, used, vmax_factor)
-        return TrialModel(self.trial.name, e, excitation_samples, neural, used, lnorm, vnorm, force, passive, moments,
-                          modeled_activations=act)
+        lnorm, vnorm = self.fiber_kinematics(muscles, design, vmax_factor)
+        a_used = lifted.get("activations", act)
+        force = self.tendon_forces(muscles, a_used, lifted.get("lengths", lnorm), lifted.get("velocities", vnorm))
+        moments = joint_moments(self.trial.moment_arms, force)
+        return TrialModel(
+            name=self.trial.name,
+            excitations=e,
+            excitations_undelayed=cs.MX(excitation_samples),
+            neural_activations=neural,
+            activations=a_used,
+            normalized_fiber_length=lnorm,
+            normalized_fiber_velocity=vnorm,
+            tendon_force=force,
+            passive_force=self.passive_forces(muscles, lnorm),
+            moments=lifted.get("moments", moments),
+            modeled_activations=act,
+            modeled_moments=moments,
+        )
 
 
-def joint_moments(moment_arms: np.ndarray, forces: cs.MX) -> cs.MX:
+def joint_moments(moment_arms: np.ndarray, forces: Any) -> cs.MX:
     """``M[k, c] = sum_m r[k, c, m] F[k, m]`` (N m) for MX forces ``(n_frames, n_muscles)``."""
     cols = [cs.sum2(cs.DM(moment_arms[:, c, :]) * forces) for c in range(moment_arms.shape[1])]
     return cs.horzcat(*cols) if cols else cs.MX(forces.shape[0], 0)
@@ -226,7 +247,7 @@ def scaled_emg_samples(emg: np.ndarray, channel_of_muscle: np.ndarray, emg_scale
     n_emg = emg.shape[0]
     m = channel_of_muscle.size
     expanded = expand_emg(emg, channel_of_muscle)
-    return cs.DM(expanded) * cs.repmat(_row(emg_scale, m), n_emg, 1)
+    return cs.DM(expanded) * cs.repmat(row(emg_scale, m), n_emg, 1)
 
 
 def expand_emg(emg: np.ndarray, channel_of_muscle: np.ndarray) -> np.ndarray:
@@ -241,8 +262,8 @@ def trial_models(
     chains: Sequence[TrialChain],
     muscles: MuscleParameters,
     design: MuscleDesign,
-    excitation_samples: Sequence[cs.MX],
+    excitation_samples: Sequence[Any],
     vmax_factor: float,
 ) -> list[TrialModel]:
-    """Modeled quantities of every trial."""
+    """Modeled quantities of every trial (nothing lifted)."""
     return [c.evaluate(muscles, design, x, vmax_factor) for c, x in zip(chains, excitation_samples)]

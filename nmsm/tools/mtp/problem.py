@@ -65,7 +65,7 @@ class MtpData:
     fiber_length_groups: tuple[MuscleGroup, ...] = ()
     synx: SynergyExtrapolation | None = None
     vmax_factor: float = 10.0
-    stride: int = 1
+    stride: int = 4
 
     @property
     def missing(self) -> tuple[int, ...]:
@@ -117,25 +117,24 @@ def modeled_trials(
     synergy_weights: Any,
     chains: Sequence[TrialChain] | None = None,
     *,
-    lifted: Sequence[Any] | None = None,
-    lifted_synx: Sequence[Any] | None = None,
+    lifted: Sequence[dict[str, Any]] | None = None,
+    lifted_synx: Sequence[dict[str, Any]] | None = None,
 ) -> tuple[list[TrialModel], list[TrialModel] | None]:
     """Modeled quantities of every trial without and (if enabled) with SynX.
 
-    ``lifted`` / ``lifted_synx``: per-trial activation matrices (n_frames, n_muscles) that
-    replace the modeled activations in forces and moments (see :class:`TrialModel`).
+    ``lifted`` / ``lifted_synx``: per trial, decision variables replacing modeled
+    quantities downstream (see :meth:`TrialChain.evaluate`).
     """
     chains = list(chains) if chains is not None else data.chains()
     plain = []
     for k, (chain, trial) in enumerate(zip(chains, data.trials)):
         x = scaled_emg_samples(trial.emg, data.channel_of_muscle, design.emg_scale)
-        act = None if lifted is None else lifted[k]
-        plain.append(chain.evaluate(data.muscles, design, x, data.vmax_factor, activations=act))
+        plain.append(chain.evaluate(data.muscles, design, x, data.vmax_factor, lifted=None if lifted is None else lifted[k]))
     synx_models = None
     if data.synx is not None:
         samples = data.synx.excitation_samples(data.expanded_emg(), design.emg_scale, synergy_weights)
         synx_models = [
-            c.evaluate(data.muscles, design, x, data.vmax_factor, activations=None if lifted_synx is None else lifted_synx[k])
+            c.evaluate(data.muscles, design, x, data.vmax_factor, lifted=None if lifted_synx is None else lifted_synx[k])
             for k, (c, x) in enumerate(zip(chains, samples))
         ]
     return plain, synx_models
@@ -185,16 +184,12 @@ def build_task_problem(
     chains = list(chains) if chains is not None else data.chains()
     lifted = lifted_synx = None
     if lift:
-        start_plain, start_synx = _activations_at(data, state, chains)
-        lifted = [problem.variable(f"activations_{t.name}", a, scale=1.0) for t, a in zip(data.trials, start_plain)]
-        if start_synx is not None:
-            lifted_synx = [
-                problem.variable(f"synx_activations_{t.name}", a, scale=1.0) for t, a in zip(data.trials, start_synx)
-            ]
+        lifted, lifted_synx = _lift(problem, data, state, chains)
     plain, synx_models = modeled_trials(data, design, weights, chains, lifted=lifted, lifted_synx=lifted_synx)
     if lift:
-        for model in plain + (synx_models or []):
-            problem.add_constraint(f"lifted_activations_{model.name}", model.activations - model.modeled_activations, 0.0, 0.0)
+        _lifting_constraints(problem, plain, lifted, "")
+        if synx_models is not None:
+            _lifting_constraints(problem, synx_models, lifted_synx, "synx_")
     ctx = MtpContext(
         muscles=data.muscles,
         design=design,
@@ -223,16 +218,54 @@ def build_task_problem(
     return problem, ctx
 
 
-def _activations_at(
-    data: MtpData, state: MtpState, chains: Sequence[TrialChain]
-) -> tuple[list[np.ndarray], list[np.ndarray] | None]:
-    """Numeric modeled activations (n_frames, n_muscles) per trial at ``state`` (plain, SynX)."""
+def _lift(
+    problem: OptimizationProblem, data: MtpData, state: MtpState, chains: Sequence[TrialChain]
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]] | None]:
+    """Lifted variables per trial, started at the modeled values of ``state``.
+
+    Activations and moments (and, shared by both, normalized fiber lengths and velocities)
+    become variables: then every constraint row depends on one muscle's parameters or on
+    one frame's values, so Jacobians and Hessians are cheap to compute and sparse.
+    """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
-    outs = [m.activations for m in plain] + [m.activations for m in (synx or [])]
-    values = [np.array(v.full()) for v in cs.Function("start_activations", [], outs).call([])]
-    n = len(plain)
-    return values[:n], (values[n:] if synx is not None else None)
+    fields = ("activations", "normalized_fiber_length", "normalized_fiber_velocity", "moments")
+    models = plain + (synx or [])
+    values = cs.Function("lift_start", [], [getattr(m, f) for m in models for f in fields]).call([])
+    start = [[np.array(values[i * len(fields) + j].full()) for j in range(len(fields))] for i in range(len(models))]
+    lifted, lifted_synx = [], []
+    for k, model in enumerate(plain):
+        a, l, v, mom = start[k]
+        name = model.name
+        lifted.append({
+            "activations": problem.variable(f"activations_{name}", a, scale=1.0),
+            "lengths": problem.variable(f"normalized_fiber_lengths_{name}", l, scale=1.0),
+            "velocities": problem.variable(f"normalized_fiber_velocities_{name}", v, scale=1.0),
+            "moments": problem.variable(f"moments_{name}", mom, scale=np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)),
+        })
+    if synx is None:
+        return lifted, None
+    for k, model in enumerate(synx):
+        a, _, _, mom = start[len(plain) + k]
+        lifted_synx.append({
+            "activations": problem.variable(f"synx_activations_{model.name}", a, scale=1.0),
+            "lengths": lifted[k]["lengths"],
+            "velocities": lifted[k]["velocities"],
+            "moments": problem.variable(f"synx_moments_{model.name}", mom, scale=np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)),
+        })
+    return lifted, lifted_synx
+
+
+def _lifting_constraints(problem: OptimizationProblem, models: Sequence[TrialModel],
+                         lifted: Sequence[dict[str, Any]], prefix: str) -> None:
+    """Equalities tying lifted variables to the modeled quantities."""
+    for model, values in zip(models, lifted):
+        name = model.name
+        problem.add_constraint(f"lifted_{prefix}activations_{name}", values["activations"] - model.modeled_activations, 0.0, 0.0)
+        problem.add_constraint(f"lifted_{prefix}moments_{name}", values["moments"] - model.modeled_moments, 0.0, 0.0)
+        if not prefix:
+            problem.add_constraint(f"lifted_lengths_{name}", values["lengths"] - model.normalized_fiber_length, 0.0, 0.0)
+            problem.add_constraint(f"lifted_velocities_{name}", values["velocities"] - model.normalized_fiber_velocity, 0.0, 0.0)
 
 
 def updated_state(state: MtpState, values: dict[str, np.ndarray]) -> MtpState:

@@ -205,29 +205,31 @@ class StructuredHessian:
             acts = commands @ weights
             grad = quad.activation_gradient(t, acts)  # (P, M)
             q = quad.q[t]
-            z = np.einsum("pmk,sk->pms", q, weights)  # Q W^T  (P, M, S)
-            v = np.einsum("sm,pmr->psr", weights, z)  # W Q W^T (P, S, S)
+            z = q @ weights.T  # Q W^T  (P, M, S)
+            v = weights @ z  # W Q W^T (P, S, S)
             n_nodes, n_syn = nodes.shape
-            # rows/cols: node vec index n + N*s  (array order [s, n])
-            h_nn.append(np.einsum("pn,pq,psr->snrq", basis, basis, v).reshape(n_syn * n_nodes, n_syn * n_nodes))
+            # H_NN[s, n, r, q'] = sum_p B[p,n] B[p,q'] V[p,s,r]; rows/cols node vec n + N*s (order [s, n])
+            bb = basis[:, :, None] * basis[:, None, :]
+            h_nn.append(np.tensordot(v, bb, axes=(0, 0)).transpose(0, 2, 1, 3).reshape(n_syn * n_nodes, n_syn * n_nodes))
             bg = basis.T @ grad  # (N, M)
             hwn = np.zeros((n_w, n_nodes * n_syn))
             for g in range(n_groups):
                 ss, ms = layout.synergy_slice(g), layout.muscle_slice(g)
                 s_g, m_g = ss.stop - ss.start, ms.stop - ms.start
-                # Σ_p C[p,s] B[p,n] Z[p,m,r]  -> (s, m, n, r)
-                part = np.einsum("ps,pn,pmr->smnr", commands[:, ss], basis, z[:, ms, :])
+                # part[s, n, m, r] = sum_p C[p,s] B[p,n] Z[p,m,r]
+                part = np.tensordot(commands[:, ss, None] * basis[:, None, :], z[:, ms, :], axes=(0, 0))
                 # curvature of the bilinear map: [s == r] (B^T G)[n, m]
-                for k, s in enumerate(range(ss.start, ss.stop)):
-                    part[k, :, :, s] += bg[:, ms].T
-                # rows: block vec index s + S_g*m (order [m, s]); cols: node vec n + N*r (order [r, n])
-                hwn[w_off[g] : w_off[g + 1]] = part.transpose(1, 0, 3, 2).reshape(m_g * s_g, n_syn * n_nodes)
+                for k, s_global in enumerate(range(ss.start, ss.stop)):
+                    part[k, :, :, s_global] += bg[:, ms]
+                # rows: block vec s + S_g*m (order [m, s]); cols: node vec n + N*r (order [r, n])
+                hwn[w_off[g] : w_off[g + 1]] = part.transpose(2, 0, 3, 1).reshape(m_g * s_g, n_syn * n_nodes)
                 for g2 in range(n_groups):
                     ss2, ms2 = layout.synergy_slice(g2), layout.muscle_slice(g2)
                     s_g2, m_g2 = ss2.stop - ss2.start, ms2.stop - ms2.start
-                    ww = np.einsum("ps,pt,pmk->smtk", commands[:, ss], commands[:, ss2], q[:, ms, ms2])
-                    # rows s + S_g*m, cols t + S_g2*k
-                    h_ww[w_off[g] : w_off[g + 1], w_off[g2] : w_off[g2 + 1]] += ww.transpose(1, 0, 3, 2).reshape(
+                    # ww[s, t, m, k] = sum_p C[p,s] C[p,t] Q[p,m,k]; rows s + S_g*m, cols t + S_g2*k
+                    cc = commands[:, ss, None] * commands[:, None, ss2]
+                    ww = np.tensordot(cc, q[:, ms, ms2], axes=(0, 0))
+                    h_ww[w_off[g] : w_off[g + 1], w_off[g2] : w_off[g2 + 1]] += ww.transpose(2, 0, 3, 1).reshape(
                         m_g * s_g, m_g2 * s_g2
                     )
             cross.append(hwn)

@@ -54,6 +54,7 @@ class NcpSetup:
     osimx: OsimxModel | None
     mtp_activation_files: tuple[Path, ...] | None
     dropped_coordinates: tuple[str, ...] = ()
+    osimx_file: Path | None = None
 
 
 def tracked_coordinates(settings: NeuralControlPersonalizationSettings, prefix: str) -> tuple[list[str], list[str]]:
@@ -73,17 +74,80 @@ def tracked_coordinates(settings: NeuralControlPersonalizationSettings, prefix: 
     return kept, dropped
 
 
+#: 2023 ``.osimx`` children (inside ``<MTPMuscleSet>``) holding MTP's length scale factors
+_OLD_SCALE_FACTORS = {
+    "optimal_fiber_length_scale_factor": "optimal_fiber_length",
+    "slack_tendon_length_scale_factor": "tendon_slack_length",
+    "tendon_slack_length_scale_factor": "tendon_slack_length",
+}
+
+
+def _old_scale_factors(extra: Sequence[str]) -> dict[str, float]:
+    """``{field: factor}`` from a 2023 RCNLMuscle's unknown children (``*_scale_factor``)."""
+    from lxml import etree
+
+    out = {}
+    for item in extra:
+        element = etree.fromstring(item)
+        field = _OLD_SCALE_FACTORS.get(element.tag)
+        if field is not None and (element.text or "").strip():
+            out[field] = float(element.text)
+    return out
+
+
 def _muscle_parameters(model: Model, muscles: Sequence[str], osimx: OsimxModel | None) -> MuscleParameters:
-    """Model parameters of ``muscles``, replaced by the osimx's absolute values where given."""
+    """Model parameters of ``muscles``, replaced by the osimx's values where given.
+
+    Current ``.osimx`` files hold absolute l_o, l_ts, F0; 2023 files hold l_o and l_ts scale
+    factors (``optimal_fiber_length_scale_factor``, ``slack_tendon_length_scale_factor``), applied
+    to the model's values here.
+    """
     f0, lo, lts, alpha = [], [], [], []
+    scaled = 0
     for name in muscles:
         m = model.muscle(name)
         personal = osimx.muscles.get(name) if osimx is not None else None
-        f0.append(personal.max_isometric_force if personal and personal.max_isometric_force is not None else m.max_isometric_force)
-        lo.append(personal.optimal_fiber_length if personal and personal.optimal_fiber_length is not None else m.optimal_fiber_length)
-        lts.append(personal.tendon_slack_length if personal and personal.tendon_slack_length is not None else m.tendon_slack_length)
+        values = {
+            "max_isometric_force": m.max_isometric_force,
+            "optimal_fiber_length": m.optimal_fiber_length,
+            "tendon_slack_length": m.tendon_slack_length,
+        }
+        if personal is not None:
+            for field, factor in _old_scale_factors(personal.extra).items():
+                if getattr(personal, field) is None:
+                    values[field] = values[field] * factor
+                    scaled += 1
+            for field in values:
+                if getattr(personal, field) is not None:
+                    values[field] = getattr(personal, field)
+        f0.append(values["max_isometric_force"])
+        lo.append(values["optimal_fiber_length"])
+        lts.append(values["tendon_slack_length"])
         alpha.append(m.pennation_angle_at_optimal)
+    if scaled:
+        warnings.warn(
+            f"{scaled} 2023-style length scale factor(s) of the .osimx applied to the model's "
+            "optimal fiber / tendon slack lengths",
+            stacklevel=3,
+        )
     return MuscleParameters(muscles, f0, lo, lts, alpha)
+
+
+def _osimx_file(settings: NeuralControlPersonalizationSettings) -> Path | None:
+    """``input_osimx_file``; when empty, the single ``.osimx`` of ``mtp_results_directory`` (2023 layout)."""
+    if settings.input_osimx_file:
+        return Path(settings.input_osimx_file)
+    if settings.mtp_results_directory is None:
+        return None
+    found = sorted(Path(settings.mtp_results_directory).glob("*.osimx"))
+    if len(found) == 1:
+        warnings.warn(
+            f"{settings.settings_file}: <input_osimx_file> is empty; using the MTP results' {found[0].name} "
+            "for the MTP muscle parameters (as the 2023 NCP read <mtp_results_directory>/model.osimx)",
+            stacklevel=3,
+        )
+        return found[0]
+    return None
 
 
 def _mtp_activations(
@@ -163,7 +227,8 @@ def load_ncp(
             stacklevel=2,
         )
     raw = [load_trial(settings.data_directory, p, coordinates, muscles) for p in prefixes]
-    osimx = read_osimx(settings.input_osimx_file) if settings.input_osimx_file else None
+    osimx_path = _osimx_file(settings)
+    osimx = read_osimx(osimx_path) if osimx_path is not None else None
     mtp_muscles: tuple[str, ...] = ()
     mtp_data: list[np.ndarray | None] = [None] * len(raw)
     files = None
@@ -213,7 +278,7 @@ def load_ncp(
         v_max_factor=settings.v_max_factor,
     )
     terms = tuple(build_terms(list(settings.cost_terms), "NCP"))
-    return NcpSetup(settings, model, inputs, terms, osimx, files, tuple(dropped))
+    return NcpSetup(settings, model, inputs, terms, osimx, files, tuple(dropped), osimx_path)
 
 
 def _load_labels(settings: NeuralControlPersonalizationSettings, prefix: str, coordinates: Sequence[str]) -> tuple[str, ...]:

@@ -40,6 +40,8 @@ COMBINED_SUFFIX = "_combinedActivations.sto"
 MOMENTS_FOLDER = "modelMoments"
 COMBINED_MOMENTS_SUFFIX = "_modeledMomentsMtpNcpCombined.sto"
 NCP_MOMENTS_SUFFIX = "_modeledMomentsNcp.sto"
+#: machine-readable description of a run (inputs used), read by the plots
+RUN_INFO_FILE = "ncpRunInfo.json"
 
 
 def combined_activations(inputs: NcpInputs, solution: SynergySolution, trial: int) -> np.ndarray:
@@ -78,6 +80,35 @@ def write_trial_files(folder: Path, inputs: NcpInputs, solution: SynergySolution
             cols = {label: moments[:, j] for j, label in enumerate(labels)}
             written.append(write_storage(folder / MOMENTS_FOLDER / f"{trial.name}{suffix}", table_from_columns(trial.time, cols)))
     return written
+
+
+def write_run_info(path: Path, setup: object) -> Path:
+    """``ncpRunInfo.json``: absolute paths of the inputs and the layout, for :mod:`nmsm.plots.ncp`."""
+    import json
+
+    from nmsm.io.trials import find_trial_file as _find
+
+    settings = setup.settings  # type: ignore[attr-defined]
+    inputs: NcpInputs = setup.inputs  # type: ignore[attr-defined]
+    mtp_files = setup.mtp_activation_files  # type: ignore[attr-defined]
+    trials = []
+    for t, trial in enumerate(inputs.trials):
+        trials.append({
+            "name": trial.name,
+            "inverse_dynamics": str(_find(Path(settings.data_directory) / "IDData", trial.name).resolve()),
+            "mtp_activations": str(Path(mtp_files[t]).resolve()) if mtp_files else None,
+        })
+    info = {
+        "settings_file": str(Path(settings.settings_file).resolve()),
+        "model_file": str(Path(settings.input_model_file).resolve()),
+        "coordinates": list(inputs.coordinates),
+        "load_labels": list(inputs.trials[0].load_labels) if inputs.trials else [],
+        "groups": [{"name": g.name, "muscles": list(g.muscles), "synergies": g.n_synergies} for g in inputs.layout.groups],
+        "mtp_muscles": list(inputs.mtp_muscles),
+        "trials": trials,
+    }
+    path.write_text(json.dumps(info, indent=1), encoding="utf-8")
+    return path
 
 
 def osimx_file_name(input_osimx: Path | None, model_file: Path) -> str:

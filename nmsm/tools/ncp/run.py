@@ -27,12 +27,14 @@ from nmsm.tools.ncp.initial_guess import initial_guess
 from nmsm.tools.ncp.loading import NcpSetup, load_ncp
 from nmsm.tools.ncp.metrics import FitMetrics, fit_metrics
 from nmsm.tools.ncp.outputs import (
+    RUN_INFO_FILE,
     WEIGHTS_FILE,
     ncp_osimx,
     osimx_file_name,
     relative_model_path,
     write_ncp_osimx,
     write_synergy_weights,
+    write_run_info,
     write_trial_files,
 )
 from nmsm.tools.ncp.problem import build_problem, score
@@ -64,10 +66,9 @@ def read_settings(path: str | os.PathLike[str]) -> NeuralControlPersonalizationS
 def _ipopt_options(settings: NeuralControlPersonalizationSettings, overrides: dict[str, Any]) -> dict[str, Any]:
     options: dict[str, Any] = {
         "max_iter": int(settings.max_iterations),
-        "tol": 1e-6,
-        "acceptable_tol": 1e-4,
+        "tol": 1e-8,
+        "acceptable_tol": 1e-6,
         "print_level": 5,
-        "ipopt_options": {"mu_strategy": "adaptive"},
     }
     options.update({k: v for k, v in overrides.items() if v is not None})
     return options
@@ -137,10 +138,10 @@ def run_settings(
     metrics = fit_metrics(setup.inputs, solution)
     out_dir = Path(settings.results_directory)
     inputs_used = [settings.input_model_file, settings.settings_file]
-    if settings.input_osimx_file:
-        inputs_used.append(settings.input_osimx_file)
+    if setup.osimx_file is not None:
+        inputs_used.append(setup.osimx_file)
     results = ResultsDirectory(out_dir, inputs=[p for p in inputs_used if p])
-    osimx_name = osimx_file_name(settings.input_osimx_file, settings.input_model_file)
+    osimx_name = osimx_file_name(setup.osimx_file, settings.input_model_file)
     wall = time.perf_counter() - start
     with results.task("ncp") as stage:
         write_synergy_weights(stage / WEIGHTS_FILE, solution)
@@ -152,6 +153,7 @@ def run_settings(
             setup.inputs,
         )
         write_ncp_osimx(stage / osimx_name, osimx)
+        write_run_info(stage / RUN_INFO_FILE, setup)
         settings_copy = out_dir / Path(settings.settings_file).name
         if settings_copy.resolve() != Path(settings.settings_file).resolve():
             shutil.copy2(settings.settings_file, stage / settings_copy.name)

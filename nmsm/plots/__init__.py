@@ -1,0 +1,1 @@
+"""Figures made from saved results (matplotlib), one module per tool; ``nmsm plot`` picks by folder content."""

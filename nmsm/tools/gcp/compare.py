@@ -1,0 +1,64 @@
+"""Score a finished GCP result (ours or the MATLAB original's) with nmsm's cost.
+
+A result is an ``.osimx`` (springs, spring constants, surface properties) plus each foot's
+optimized kinematics file (``*_Foot_<n>_optimizedFootKinematics.sto``). The kinematics are
+turned back into B-spline coefficients: the original's optimized kinematics are exactly
+``N (base * C)`` on the same basis, so ``nodes = lstsq(N, q)`` and ``C = nodes / base``.
+:func:`result_state` returns the matching :class:`~nmsm.tools.gcp.state.GcpState`; the
+feet must be built with that ``.osimx``'s springs (``build_foot_inputs(..., osimx)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from nmsm.errors import InputError
+from nmsm.io.osimx import OsimxModel
+from nmsm.io.storage import read_storage
+from nmsm.tools.gcp import bspline
+from nmsm.tools.gcp.inputs import FootInputs, matching_osimx_surface
+from nmsm.tools.gcp.state import GcpState
+
+#: smallest |base node| divided by: coefficients of (near) zero base nodes are set to 1
+_TINY = 1e-12
+
+
+def coefficients_from_kinematics(foot: FootInputs, coordinates: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(C (m, 7), max reconstruction error)`` of optimized foot coordinates (T, 7)."""
+    nodes = bspline.fit_nodes(foot.basis, coordinates)
+    base = foot.base_nodes
+    safe = np.where(np.abs(base) > _TINY, base, 1.0)
+    coefficients = np.where(np.abs(base) > _TINY, nodes / safe, 1.0)
+    rebuilt = foot.basis @ (base * coefficients)
+    return coefficients, float(np.abs(rebuilt - coordinates).max())
+
+
+def result_state(osimx: OsimxModel, kinematics_files: Sequence[Path], feet: Sequence[FootInputs]) -> GcpState:
+    """The :class:`GcpState` of a finished result (module docstring). Electrical-center
+    shifts and plate rotations are not stored in an ``.osimx``: they are 0."""
+    surfaces = [matching_osimx_surface(osimx, f.surface) for f in feet]
+    if any(s is None for s in surfaces):
+        raise InputError("the result has no contact surface for every foot", expected="one surface per hindfoot body")
+    first = surfaces[0]
+    coefficients = []
+    for foot, path in zip(feet, kinematics_files):
+        table = read_storage(path)
+        if table.n_rows != foot.n_frames or np.abs(table.time - foot.time).max() > 1e-6:
+            raise InputError(f"{table.n_rows} frames, foot window has {foot.n_frames}", file=path,
+                             expected="the foot's time window")
+        c, _ = coefficients_from_kinematics(foot, table.data[:, :7])
+        coefficients.append(c)
+    return GcpState(
+        spring_constants=np.array([s.spring_constant for s in first.springs], dtype=float),
+        damping_factor=first.damping_factor,
+        dynamic_friction_coefficient=first.dynamic_friction_coefficient,
+        viscous_friction_coefficient=first.viscous_friction_coefficient,
+        resting_spring_length=first.resting_spring_length,
+        latching_velocity=first.latching_velocity,
+        coefficients=coefficients,
+        electrical_center_shifts=[np.zeros(3) for _ in feet],
+        plate_rotations=[0.0 for _ in feet],
+    )

@@ -1,0 +1,54 @@
+"""Block-wise exact derivatives for IPOPT (``jac_g`` and ``hess_lag`` nlpsol options).
+
+CasADi's default Jacobian of the constraints and Hessian of the Lagrangian colour the
+*whole* sparsity pattern at once, so one block that needs many colours (MTP's moment
+rows, which touch every muscle of a frame) makes every block pay for them. Here each
+constraint block and the objective get their own derivative (their own colouring, forward
+or reverse), and the results are stacked / summed. Values are identical to the
+default; only the cost changes.
+
+Use: ``problem.solve("ipopt", casadi_options=blockwise_derivatives(problem))``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as cs
+
+from nmsm.core.problem import OptimizationProblem
+
+
+def blockwise_derivatives(problem: OptimizationProblem) -> dict[str, Any]:
+    """``{"jac_g": Function(x, p) -> (g, J), "hess_lag": Function(x, p, lam_f, lam_g) -> H}``.
+
+    ``H`` is the upper triangle (``triu``) of the symmetric Hessian, as CasADi's own
+    ``nlp_hess_l`` returns it.
+    """
+    x = problem.scaled_vector()
+    p = problem.parameter_vector()
+    g, _, _ = problem.constraint_vector()
+    blocks = [c.expression for c in problem.constraints]
+    jac = cs.vertcat(*[cs.jacobian(b, x) for b in blocks]) if blocks else cs.MX(0, x.numel())
+    jac_g = cs.Function("nlp_jac_g", [x, p], [g, jac], ["x", "p"], ["g", "jac_g_x"])
+    lam_f = cs.MX.sym("lam_f")
+    lam_g = cs.MX.sym("lam_g", g.numel())
+    hess = lam_f * _hessian(problem.objective(), x)
+    start = 0
+    for b in blocks:
+        n = b.numel()
+        if n:
+            hess = hess + _hessian(cs.dot(lam_g[start : start + n], b), x)
+        start += n
+    hess_lag = cs.Function(
+        "nlp_hess_l", [x, p, lam_f, lam_g], [cs.triu(hess)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+    )
+    return {"jac_g": jac_g, "hess_lag": hess_lag}
+
+
+def _hessian(expression: cs.MX, x: cs.MX) -> cs.MX:
+    """Symmetric Hessian of a scalar MX expression (zero if it does not depend on ``x``)."""
+    if not cs.depends_on(expression, x):
+        return cs.MX(x.numel(), x.numel())
+    h, _ = cs.hessian(expression, x)
+    return h

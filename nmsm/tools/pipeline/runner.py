@@ -1,0 +1,259 @@
+"""Running a pipeline file: ``nmsm pipeline PIPELINE.xml`` / :func:`nmsm.run_pipeline`.
+
+For each enabled stage, in order:
+
+1. read its settings (file or embedded; old schemas upgraded), rewire its inputs to the
+   artifacts available so far (:mod:`nmsm.tools.pipeline.wiring`), point its
+   ``results_directory`` at ``<results>/<stage name>/`` and make every other path absolute;
+2. hash its inputs (settings plus the contents of every file and folder they name);
+3. if ``pipeline_state.json`` records that digest and the recorded outputs are unchanged,
+   skip it ("up to date"); otherwise write ``<results>/<stage name>.xml`` (a settings file
+   ``nmsm run`` accepts), empty the stage's folder, run the tool on that file, find its
+   outputs and record the stage.
+
+A stop (Ctrl-C, a failure) leaves the finished stages recorded: the next run skips them and
+redoes the stopped one. Results tree::
+
+    <results_directory>/
+        pipeline.xml              copy of the pipeline file
+        pipeline_state.json       records of finished stages (:mod:`nmsm.tools.pipeline.state`)
+        pipeline_summary.txt      what ran, what was up to date, times, outputs
+        <stage>.xml               each stage's settings, inputs wired (``nmsm run <stage>.xml``)
+        <stage>/                  each stage's results
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import shutil
+import time
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+import attrs
+
+from nmsm.errors import InputError
+from nmsm.tools.pipeline.artifacts import Artifacts
+from nmsm.tools.pipeline.hashing import DigestCache
+from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
+from nmsm.tools.pipeline.plan import check_inputs, check_order
+from nmsm.tools.pipeline.stage_settings import StageSettings
+from nmsm.tools.pipeline.state import VERSION, PipelineState, StageRecord
+from nmsm.tools.pipeline.wiring import wire_stage
+
+PIPELINE_COPY = "pipeline.xml"
+SUMMARY_FILE = "pipeline_summary.txt"
+#: names a stage may not take (files of the results tree)
+RESERVED_NAMES = ("pipeline", "pipeline_state", "pipeline_summary", "report", "plots")
+
+RAN, UP_TO_DATE, DISABLED, NOT_SELECTED = "ran", "up to date", "disabled", "not selected"
+
+
+@attrs.frozen
+class StageOutcome:
+    """What happened to one stage in a run."""
+
+    name: str
+    kind: str
+    label: str
+    status: str
+    wall_time: float  #: s (this run's, or the recorded one when up to date)
+    settings_file: Path | None
+    results_directory: Path | None
+    outputs: dict[str, Path]
+    wired: dict[str, str]
+    result: Any = None  #: what the tool returned, when it ran
+
+
+@attrs.frozen
+class PipelineRun:
+    """A finished pipeline run."""
+
+    spec: PipelineSpec
+    results_directory: Path
+    stages: tuple[StageOutcome, ...]
+    wall_time: float
+
+    def stage(self, name: str) -> StageOutcome:
+        for outcome in self.stages:
+            if outcome.name == name:
+                return outcome
+        raise KeyError(name)
+
+    def summary(self) -> str:
+        lines = [f"pipeline '{self.spec.name}' ({self.spec.file}) -> {self.results_directory}"]
+        for s in self.stages:
+            timing = f"{s.wall_time:8.1f} s" if s.status in (RAN, UP_TO_DATE) else " " * 10
+            lines.append(f"  {s.name:<14s} {s.kind:<10s} {s.status:<12s} {timing}")
+            for element, source in s.wired.items():
+                lines.append(f"      {element} <- {source}")
+        lines.append(f"total {self.wall_time:.1f} s")
+        return "\n".join(lines)
+
+
+def _relative(path: Path, root: Path) -> str:
+    return Path(os.path.relpath(path.resolve(), root.resolve())).as_posix()
+
+
+def _stage_folder(results: Path, stage: StageSpec) -> Path:
+    return results / stage.name
+
+
+def prepare_stage(stage: StageSpec, artifacts: Artifacts, results: Path) -> tuple[StageSettings, dict[str, str]]:
+    """The stage's settings wired to ``artifacts``, results in ``<results>/<name>``, paths absolute."""
+    settings = stage.load_settings()
+    wired = wire_stage(stage.kind, settings, artifacts, stage.keep)
+    settings.set_path("results_directory", _stage_folder(results, stage))
+    settings.absolutize()
+    return settings, wired
+
+
+def _outputs_intact(record: StageRecord, results: Path, cache: DigestCache) -> bool:
+    for path in record.outputs.values():
+        if not (results / path).exists():
+            return False
+    folder = results / record.results_directory
+    return folder.is_dir() and cache.folder(folder) == record.output_digest
+
+
+def _check_names(spec: PipelineSpec) -> None:
+    for stage in spec.stages:
+        if stage.name in RESERVED_NAMES:
+            raise stage.error(f"the name '{stage.name}' is reserved for a file of the results tree",
+                              element="<Stage name>", expected="another name")
+
+
+def _selection(spec: PipelineSpec, only: Sequence[str] | None, until: str | None) -> set[str]:
+    names = [s.name for s in spec.stages]
+    for name in [*(only or ()), *([until] if until else [])]:
+        if name not in names:
+            raise InputError(f"no stage named '{name}'", file=spec.file, element="<Stage name>",
+                             expected="one of " + ", ".join(names))
+    selected = set(only) if only else set(names)
+    if until:
+        selected &= set(names[: names.index(until) + 1])
+    return selected
+
+
+def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until: str | None = None,
+                 rebuild: bool = False, force: Iterable[str] = (), check_only: bool = False,
+                 log: Callable[[str], None] | None = print, stage_options: dict[str, dict[str, Any]] | None = None,
+                 ) -> PipelineRun:
+    """Run a parsed pipeline (see module docstring).
+
+    ``only``: run just these stages (the others must be up to date when a selected stage
+    needs their outputs); ``until``: stop after this stage; ``rebuild``: redo every stage;
+    ``force``: redo these stages; ``check_only``: validate and report which stages would
+    run, without running anything. ``stage_options``: extra keyword arguments per stage
+    name for its tool's ``run_settings``.
+    """
+    say = log or (lambda text: None)
+    start = time.perf_counter()
+    _check_names(spec)
+    check_order(spec)
+    results = spec.results_directory
+    enabled = [s for s in spec.stages if s.enabled]
+    check_inputs(spec, {s.name: s.load_settings() for s in enabled})
+    selected = _selection(spec, only, until)
+    state = PipelineState.load(results)
+    forced = set(force) | ({s.name for s in spec.stages} if rebuild else set())
+    cache = DigestCache(exclude=[results])
+    artifacts = Artifacts()
+    unavailable: dict[str, str] = {}  # artifact -> stage that should have made it but did not run
+    for name, path in spec.inputs.items():
+        artifacts.provide(name, path, "the pipeline inputs")
+    if not check_only:
+        results.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(spec.file, results / PIPELINE_COPY)
+    outcomes: list[StageOutcome] = []
+    for number, stage in enumerate(spec.stages, start=1):
+        head = f"[{number}/{len(spec.stages)}] {stage.name} ({stage.kind.label})"
+        if not stage.enabled:
+            outcomes.append(StageOutcome(stage.name, stage.kind.code, stage.kind.label, DISABLED, 0.0, None, None,
+                                         {}, {}))
+            say(f"{head}: disabled")
+            continue
+        settings, wired = prepare_stage(stage, artifacts, results)
+        digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}")
+        record = state.records.get(stage.name)
+        current = (record is not None and record.input_digest == digest and record.kind == stage.kind.code
+                   and stage.name not in forced and _outputs_intact(record, results, cache))
+        settings_file = results / f"{stage.name}.xml"
+        folder = _stage_folder(results, stage)
+        if current:
+            assert record is not None
+            outputs = {k: results / v for k, v in record.outputs.items()}
+            for artifact, path in outputs.items():
+                artifacts.provide(artifact, path, f"stage '{stage.name}'")
+                unavailable.pop(artifact, None)
+            outcomes.append(StageOutcome(stage.name, stage.kind.code, stage.kind.label, UP_TO_DATE,
+                                         record.wall_time, settings_file, folder, outputs, wired))
+            say(f"{head}: up to date")
+            continue
+        if stage.name not in selected or check_only:
+            status = NOT_SELECTED if stage.name not in selected else "would run"
+            outcomes.append(StageOutcome(stage.name, stage.kind.code, stage.kind.label, status, 0.0,
+                                         settings_file, folder, {}, wired))
+            say(f"{head}: {status}")
+            for artifact in stage.kind.produces:
+                artifacts.items.pop(artifact, None)
+                unavailable[artifact] = stage.name
+            continue
+        _require_available(stage, unavailable)
+        say(f"{head}: running")
+        outcome = _run_stage(stage, settings, settings_file, folder, results, digest, state, cache, wired,
+                             (stage_options or {}).get(stage.name, {}))
+        for artifact, path in outcome.outputs.items():
+            artifacts.provide(artifact, path, f"stage '{stage.name}'")
+            unavailable.pop(artifact, None)
+        outcomes.append(outcome)
+        say(f"{head}: finished in {outcome.wall_time:.1f} s")
+    run = PipelineRun(spec, results, tuple(outcomes), time.perf_counter() - start)
+    if not check_only:
+        (results / SUMMARY_FILE).write_text(run.summary() + "\n")
+    return run
+
+
+def _require_available(stage: StageSpec, unavailable: dict[str, str]) -> None:
+    """:class:`InputError` when the stage needs an output of a stage that did not run now."""
+    needed = [a for a in (*stage.kind.requires, *stage.kind.uses) if a in unavailable]
+    if needed:
+        other = unavailable[needed[0]]
+        raise stage.error(f"needs the outputs of stage '{other}' ({needed[0]}), which is not up to date and was "
+                          "not selected", expected=f"stage '{other}' selected too, or run first")
+
+
+def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, folder: Path, results: Path,
+               digest: str, state: PipelineState, cache: DigestCache, wired: dict[str, str],
+               options: dict[str, Any]) -> StageOutcome:
+    state.forget(stage.name)
+    if folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
+    settings_file.write_text(settings.text(settings_file, results))
+    began = time.perf_counter()
+    result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})
+    wall = time.perf_counter() - began
+    outputs = stage.kind.load_outputs()(settings, folder)
+    record = StageRecord(
+        name=stage.name,
+        kind=stage.kind.code,
+        tool=stage.kind.tool_element,
+        settings_file=_relative(settings_file, results),
+        results_directory=_relative(folder, results),
+        input_digest=digest,
+        outputs={k: _relative(v, results) for k, v in outputs.items()},
+        output_digest=cache.folder(folder),
+        finished=datetime.datetime.now().isoformat(timespec="seconds"),
+        wall_time=wall,
+    )
+    state.record(record)
+    return StageOutcome(stage.name, stage.kind.code, stage.kind.label, RAN, wall, settings_file, folder, outputs,
+                        wired, result)
+
+
+def run_pipeline_file(pipeline_file: str | os.PathLike[str], **options: Any) -> PipelineRun:
+    """Read and run a pipeline file; ``options`` as :func:`run_pipeline`."""
+    return run_pipeline(read_pipeline(pipeline_file), **options)

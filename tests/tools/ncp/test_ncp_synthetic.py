@@ -1,0 +1,62 @@
+"""Known-answer NCP: synergies and moments generated in code are recovered; outputs and plots."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nmsm.examples.synthetic_ncp import run_synthetic_ncp
+from nmsm.io.osimx import read_osimx
+from nmsm.io.storage import read_storage
+from nmsm.plots.ncp import plot_ncp_results
+from nmsm.tools.dispatch import run_settings_file
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_synthetic_synergies_are_recovered(tmp_path, symmetric) -> None:
+    result = run_synthetic_ncp(tmp_path, symmetric=symmetric, n_synergies=3)
+    run = result.run
+    assert run.solver.success
+    for side, similarity in result.cosine_similarity.items():
+        assert similarity.min() >= 0.99, (side, similarity)
+    peak = max(np.abs(m).max() for m in result.case.true_moments)
+    assert result.moment_rms.max() <= 1e-4 * peak
+    assert result.activation_rms <= 1e-3
+    if symmetric:  # shared vectors: the left block mirrors the right one exactly
+        layout = run.solution.layout
+        right, left = run.solution.group_weights(0), run.solution.group_weights(1)
+        order = [layout.groups[0].muscles.index(m.replace("_l", "_r")) for m in layout.groups[1].muscles]
+        assert np.array_equal(left, right[:, order])
+
+
+def test_synthetic_outputs(tmp_path) -> None:
+    result = run_synthetic_ncp(tmp_path / "case")
+    case, run = result.case, result.run
+    folder = case.folder / "results"
+    assert run.results_directory == folder
+    weights = read_storage(folder / "synergyWeights.sto")
+    assert weights.n_rows == 6 and set(weights.labels) == set(case.muscles)
+    assert np.allclose(weights.data.max(axis=1), 1.0)
+    assert list(weights.time) == [1, 2, 3, 4, 5, 6]
+    commands = read_storage(folder / "trial_1_synergyCommands.sto")
+    assert commands.labels == ("RightLeg_1", "RightLeg_2", "RightLeg_3", "LeftLeg_1", "LeftLeg_2", "LeftLeg_3")
+    combined = read_storage(folder / "trial_1_combinedActivations.sto")
+    mtp = read_storage(case.folder / "mtp" / "muscleActivations" / "trial_1_muscleActivations.sto")
+    assert np.array_equal(combined.columns(list(mtp.labels)), mtp.data)  # MTP muscles keep MTP's activations
+    moments = read_storage(folder / "modelMoments" / "trial_1_modeledMomentsNcp.sto")
+    assert moments.labels[0] == "hip_flexion_r_moment"
+    assert (folder / "modelMoments" / "trial_2_modeledMomentsMtpNcpCombined.sto").is_file()
+    osimx = read_osimx(folder / "legs_mtp_ncp.osimx")
+    assert [(s.muscle_group_name, s.num_synergies) for s in osimx.synergies] == [("RightLeg", 3), ("LeftLeg", 3)]
+    assert osimx.muscles["soleus_r"].optimal_fiber_length == pytest.approx(read_osimx(case.osimx_file).muscles["soleus_r"].optimal_fiber_length)
+    assert (folder / "NCPSettings.xml").is_file() and "moment RMS" in (folder / "commandWindowOutput.txt").read_text()
+    figures = plot_ncp_results(folder)
+    assert {p.name for p in figures} >= {"synergyVectors.png", "trial_1_momentMatching.png", "trial_2_activationMatching.png"}
+    assert all(p.stat().st_size > 10_000 for p in figures)
+
+
+def test_dispatcher_runs_ncp_settings(tmp_path) -> None:
+    result = run_synthetic_ncp(tmp_path / "a")
+    again = run_settings_file(result.case.settings_file, results_directory=tmp_path / "b", print_level=0)
+    assert (tmp_path / "b" / "synergyWeights.sto").is_file()
+    assert again.costs["total"] == pytest.approx(result.run.costs["total"], rel=1e-6)

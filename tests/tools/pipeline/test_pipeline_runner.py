@@ -1,0 +1,205 @@
+"""The pipeline runner on fake stages: wiring, skipping up-to-date stages, resuming after a
+stop, re-running what changed, settings written into the results tree, bad input."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from fake_stages import CALLS, STOP_NEXT, fake_kinds  # noqa: E402
+
+from nmsm.errors import InputError  # noqa: E402
+from nmsm.tools.pipeline.runner import RAN, UP_TO_DATE, run_pipeline_file  # noqa: E402
+from nmsm.tools.pipeline.state import STATE_FILE  # noqa: E402
+
+MAKER_SETTINGS = """<NMSMPipelineDocument Version="1.5.3"><FakeMakerTool>
+  <results_directory>ignored_out</results_directory>
+  <input_model_file>model.osim</input_model_file>
+  <output_model_file>made.osim</output_model_file>
+  <offset>{offset}</offset>
+</FakeMakerTool></NMSMPipelineDocument>
+"""
+
+
+def _pipeline(folder: Path, *, offset: str = "1", order: str = "maker fitter", fitter_data: str = "data",
+              keep: str = "") -> Path:
+    (folder / "maker.xml").write_text(MAKER_SETTINGS.format(offset=offset))
+    stages = {
+        "maker": '<Stage name="make"><settings_file>maker.xml</settings_file></Stage>',
+        "fitter": (f'<Stage name="fit"><keep_settings_inputs>{keep}</keep_settings_inputs>'
+                   f'<FakeFitterTool><results_directory/><input_model_file>model.osim</input_model_file>'
+                   f'<data_directory>{fitter_data}</data_directory></FakeFitterTool></Stage>'),
+    }
+    body = "".join(stages[name] for name in order.split())
+    path = folder / "pipeline.xml"
+    path.write_text(f"""<NMSMPipelineDocument Version="1.5.3"><PipelineTool name="fake">
+  <results_directory>results</results_directory>
+  <StageList>{body}</StageList>
+</PipelineTool></NMSMPipelineDocument>
+""")
+    return path
+
+
+@pytest.fixture()
+def case(tmp_path: Path):
+    (tmp_path / "model.osim").write_text("<model/>\n")
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "trial_1.sto").write_text("1 2 3\n")
+    with fake_kinds():
+        yield tmp_path
+
+
+def _statuses(run) -> dict[str, str]:
+    return {s.name: s.status for s in run.stages}
+
+
+def test_chain_wires_outputs_and_writes_stage_settings(case: Path) -> None:
+    run = run_pipeline_file(_pipeline(case), log=None)
+    assert _statuses(run) == {"make": RAN, "fit": RAN}
+    results = case / "results"
+    # the fitter read the maker's model, not the settings' own model.osim
+    assert (results / "fit" / "part1.txt").read_text() == "<model/>\n<!-- offset 1 -->\n"
+    assert run.stage("fit").wired["input_model_file"] == "model from stage 'make'"
+    # each stage's settings are in the tree, with tree paths relative (movable) and inputs absolute
+    text = (results / "fit.xml").read_text()
+    assert "<input_model_file>make/made.osim</input_model_file>" in text
+    assert f"<data_directory>{(case / 'data').resolve()}</data_directory>" in text
+    assert "<results_directory>fit</results_directory>" in text
+    state = json.loads((results / STATE_FILE).read_text())
+    assert set(state["stages"]) == {"make", "fit"}
+    assert state["stages"]["fit"]["outputs"] == {"osimx": "fit/fit_mtp.osimx", "mtp_results": "fit"}
+
+
+def test_second_run_skips_everything_and_changes_rerun_downstream(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    CALLS.clear()
+    run = run_pipeline_file(pipeline, log=None)
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": UP_TO_DATE}
+    assert CALLS == []
+    # a new data file changes only the fitter's inputs
+    (case / "data" / "trial_2.sto").write_text("4 5 6\n")
+    run = run_pipeline_file(pipeline, log=None)
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": RAN}
+    assert "trial_2.sto" in (case / "results" / "fit" / "fit_mtp.osimx").read_text()
+    # a changed maker setting re-runs the maker and, through its new model, the fitter
+    CALLS.clear()
+    run = run_pipeline_file(_pipeline(case, offset="2"), log=None)
+    assert _statuses(run) == {"make": RAN, "fit": RAN}
+    assert [c[0] for c in CALLS] == ["maker", "fitter"]
+    # a changed model file changes the maker's inputs
+    (case / "model.osim").write_text("<model version='2'/>\n")
+    run = run_pipeline_file(pipeline, log=None)
+    assert _statuses(run)["make"] == RAN
+
+
+def test_stopped_pipeline_resumes_without_redoing_finished_stages(case: Path) -> None:
+    pipeline = _pipeline(case)
+    STOP_NEXT.add("fitter")
+    with pytest.raises(KeyboardInterrupt):
+        run_pipeline_file(pipeline, log=None)
+    state = json.loads((case / "results" / STATE_FILE).read_text())
+    assert list(state["stages"]) == ["make"]  # the stopped stage is not recorded
+    assert (case / "results" / "fit" / "part1.txt").exists()  # its partial output is there
+    CALLS.clear()
+    run = run_pipeline_file(pipeline, log=None)
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": RAN}
+    assert [c[0] for c in CALLS] == ["fitter"]
+
+
+def test_moved_results_tree_stays_up_to_date(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    moved = case / "moved"
+    moved.mkdir()
+    for name in ("model.osim", "maker.xml", "pipeline.xml"):
+        (moved / name).write_bytes((case / name).read_bytes())
+    (case / "data").rename(moved / "data")
+    (case / "results").rename(moved / "results")
+    CALLS.clear()
+    run = run_pipeline_file(moved / "pipeline.xml", log=None)
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": UP_TO_DATE}
+    assert CALLS == []
+
+
+def test_deleted_or_edited_outputs_rerun_the_stage(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    (case / "results" / "make" / "made.osim").write_text("edited\n")
+    run = run_pipeline_file(pipeline, log=None)
+    assert _statuses(run) == {"make": RAN, "fit": UP_TO_DATE}  # same model re-made: fitter inputs unchanged
+
+
+def test_keep_settings_inputs_leaves_the_element(case: Path) -> None:
+    run = run_pipeline_file(_pipeline(case, keep="input_model_file"), log=None)
+    assert (case / "results" / "fit" / "part1.txt").read_text() == "<model/>\n"
+    assert "input_model_file" not in run.stage("fit").wired
+
+
+def test_until_and_only_select_stages(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run = run_pipeline_file(pipeline, until="make", log=None)
+    assert _statuses(run) == {"make": RAN, "fit": "not selected"}
+    run = run_pipeline_file(pipeline, only=["fit"], log=None)
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": RAN}
+    run_pipeline_file(_pipeline(case, offset="5"), log=None, until="make")
+    run_pipeline_file(_pipeline(case, offset="6"), log=None, check_only=True)
+    with pytest.raises(InputError, match="stage 'fit'.*needs the outputs of stage 'make'"):
+        run_pipeline_file(_pipeline(case, offset="7"), only=["fit"], log=None)
+
+
+def test_rebuild_and_force(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    assert _statuses(run_pipeline_file(pipeline, force=["fit"], log=None)) == {"make": UP_TO_DATE, "fit": RAN}
+    assert _statuses(run_pipeline_file(pipeline, rebuild=True, log=None)) == {"make": RAN, "fit": RAN}
+
+
+# ---- bad input ---------------------------------------------------------------------------------
+def test_impossible_order_names_both_stages(case: Path) -> None:
+    with pytest.raises(InputError, match=r"stage 'make' \(maker\): cannot run after stage 'fit' \(fitter\)"):
+        run_pipeline_file(_pipeline(case, order="fitter maker"), log=None)
+
+
+def test_missing_input_names_stage_and_piece(case: Path) -> None:
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(_pipeline(case, order="fitter", fitter_data="no_such_folder"), log=None)
+    text = str(info.value)
+    assert "stage 'fit' (fitter)" in text and "data folder" in text and "no_such_folder" in text
+    assert "an earlier" in text and "<data_directory>" in text
+
+
+def test_results_tree_from_older_version(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    state_file = case / "results" / STATE_FILE
+    data = json.loads(state_file.read_text())
+    data["version"] = 0
+    state_file.write_text(json.dumps(data))
+    with pytest.raises(InputError, match="older nmsm pipeline.*state format version 0"):
+        run_pipeline_file(pipeline, log=None)
+    data["version"] = 1
+    del data["stages"]["fit"]["input_digest"]
+    state_file.write_text(json.dumps(data))
+    with pytest.raises(InputError, match="stage 'fit': record lacks input_digest"):
+        run_pipeline_file(pipeline, log=None)
+
+
+def test_unknown_stage_tool_and_duplicate_names(case: Path) -> None:
+    path = case / "bad.xml"
+    path.write_text('<NMSMPipelineDocument Version="1.5.3"><PipelineTool><results_directory>r</results_directory>'
+                    '<StageList><Stage><NoSuchTool/></Stage></StageList></PipelineTool></NMSMPipelineDocument>')
+    with pytest.raises(InputError, match="<NoSuchTool> is not a pipeline stage"):
+        run_pipeline_file(path, log=None)
+    path.write_text('<NMSMPipelineDocument Version="1.5.3"><PipelineTool><results_directory>r</results_directory>'
+                    '<StageList><Stage name="a"><settings_file>maker.xml</settings_file></Stage>'
+                    '<Stage name="a"><settings_file>maker.xml</settings_file></Stage></StageList>'
+                    '</PipelineTool></NMSMPipelineDocument>')
+    (case / "maker.xml").write_text(MAKER_SETTINGS.format(offset=0))
+    with pytest.raises(InputError, match="stage name 'a' used twice"):
+        run_pipeline_file(path, log=None)
