@@ -22,6 +22,23 @@ from pathlib import Path
 from nmsm.errors import InputError
 
 
+def _refuse_read_only(path: Path) -> None:
+    """Refuse a folder (or its nearest existing ancestor) without any write permission bit.
+
+    Checked on the mode bits, not with ``os.access``, so a read-only data tree is refused
+    even when running as root (who could write anyway).
+    """
+    probe = path.resolve()
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if probe.exists() and not (probe.stat().st_mode & 0o222):
+        raise InputError(
+            f"results folder {path} is inside read-only folder {probe}; nmsm does not write "
+            "there (pass another results directory, e.g. nmsm run -o RESULTS_DIR)",
+            file=path,
+        )
+
+
 class ResultsDirectory:
     """A results folder with per-task staging.
 
@@ -31,6 +48,7 @@ class ResultsDirectory:
 
     def __init__(self, path: str | os.PathLike[str], *, inputs: Iterable[str | os.PathLike[str]] = ()) -> None:
         self.path = Path(path)
+        _refuse_read_only(self.path)
         self.path.mkdir(parents=True, exist_ok=True)
         self._inputs = {Path(p).resolve() for p in inputs}
 

@@ -204,6 +204,19 @@ def muscle_volume(max_isometric_force: Any, optimal_fiber_length: Any, maximum_m
 
 
 # ----- activation ---------------------------------------------------------------------------
+def clip_negative(x: Any, smoothing: float = 0.0) -> Any:
+    """``max(x, 0)``; with ``smoothing`` > 0 the smooth ``(x + sqrt(x**2 + s**2)) / 2``.
+
+    The smooth form is C-infinity and exceeds ``max(x, 0)`` by at most ``s / 2`` (at 0), so
+    gradient-based solvers do not stall on the kink (MTP with synergy extrapolation).
+    """
+    ops = _ops(x)
+    if smoothing <= 0:
+        return ops.fmax(x, 0) if ops is not np else np.maximum(x, 0.0)
+    return 0.5 * (x + ops.sqrt(x * x + smoothing**2))
+
+
+
 def activation_nonlinearity(neural_activation: Any, nonlinearity: Any) -> Any:
     """Muscle activation from neural activation with nonlinearity constant ``A`` in [0, 0.35]."""
     g1, g2, g3, g4, g5, g6 = ACTIVATION_NONLINEARITY_G

@@ -162,6 +162,11 @@ def plot_activation_matching(ncp_activations: np.ndarray, muscles: Sequence[str]
     return path
 
 
+def is_ncp_results(folder: str | os.PathLike[str]) -> bool:
+    """True when ``folder`` looks like an NCP results folder (it holds ``synergyWeights.sto``)."""
+    return (Path(folder) / _WEIGHTS).is_file()
+
+
 def _trials(folder: Path) -> list[str]:
     return sorted(p.name[: -len(_COMMANDS)] for p in folder.glob(f"*{_COMMANDS}"))
 

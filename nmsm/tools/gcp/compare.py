@@ -62,3 +62,16 @@ def result_state(osimx: OsimxModel, kinematics_files: Sequence[Path], feet: Sequ
         electrical_center_shifts=[np.zeros(3) for _ in feet],
         plate_rotations=[0.0 for _ in feet],
     )
+
+
+def shifts_from_adjusted_grf(adjusted: Path, grf_table: object, feet: Sequence[FootInputs]) -> list[np.ndarray]:
+    """Electrical-center shifts (3,) m per foot recovered from an adjusted GRF file (the
+    original's ``GRFData/updated_<grf>``: the input file with shifted center columns)."""
+    table = read_storage(adjusted, allow_nan=lambda label: True)
+    shifts = []
+    for foot in feet:
+        rows = np.array([int(np.argmin(np.abs(table.time - t))) for t in foot.time])
+        centers = table.columns(list(foot.surface.electrical_center_columns))[rows]
+        shift = np.nanmedian(centers - foot.reactions.electrical_center, axis=0)
+        shifts.append(np.where(np.isfinite(shift), shift, 0.0))
+    return shifts

@@ -12,16 +12,19 @@ block                           name                  bounds            scale
 ``dynamicFrictionCoefficient``  dynamic_friction      [0, inf)          1
 ``viscousFrictionCoefficient``  viscous_friction      [0, inf) s/m      1
 ``restingSpringLength``         resting_length        free (m)          0.01 m
-``kinematicsBSplineCoefficients`` coefficients_<foot>  free (m, 7)       1
+``kinematicsBSplineCoefficients`` coefficients_<foot> free (m, 7)       1
 ``electricalCenterX/Y/Z``       ec_<axis>_<foot>      free (m)          0.01 m
 ``forcePlateRotation``          plate_rotation_<foot> +-0.2618 rad      (range)
 ==============================  ====================  ================  =========
 
 ``<foot>`` is the 1-based foot index. Solved with the least-squares back end (scipy
-``least_squares``, exact sparse CasADi Jacobians): ``function_tolerance`` -> ``ftol``,
+``least_squares`` 'trf', exact sparse CasADi Jacobians, LSMR trust-region steps: the
+Jacobian has ~40 times more rows than columns and an SVD of it per iteration costs more
+than the Jacobian itself, for the same steps here): ``function_tolerance`` -> ``ftol``,
 ``step_tolerance`` -> ``xtol``, ``optimality_tolerance`` -> ``gtol``, ``max_iterations``
 -> the number of residual evaluations (each trust-region iteration evaluates the residuals
-once and the Jacobian once per accepted step).
+once and the Jacobian once per accepted step). ``diff_min_change`` (a finite-difference
+step) does not apply to exact derivatives.
 """
 
 from __future__ import annotations
@@ -113,6 +116,7 @@ def solver_options(settings: GroundContactPersonalizationSettings, max_iteration
         "xtol": settings.step_tolerance,
         "gtol": settings.optimality_tolerance,
         "max_nfev": int(min(iterations, settings.max_function_evaluations)),
+        "tr_solver": "lsmr",
     }
 
 

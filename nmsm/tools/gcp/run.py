@@ -48,9 +48,8 @@ from nmsm.tools.gcp import outputs, report
 from nmsm.tools.gcp.data import full_coordinates, read_ground_reactions, read_motion
 from nmsm.tools.gcp.ik_update import updated_motion
 from nmsm.tools.gcp.inputs import FootInputs, build_foot_inputs, check_equal_spring_counts
-from nmsm.tools.gcp.problem import build_task_problem, updated_state
+from nmsm.tools.gcp.problem import build_task_problem, solver_options, updated_state
 from nmsm.tools.gcp.rest_length import initialize_resting_length
-from nmsm.tools.gcp.solver import solve_task
 from nmsm.tools.gcp.state import GcpState
 from nmsm.tools.gcp.values import FootValues, as_array, foot_values
 from nmsm.tools.jmp.ik import motion_table
@@ -104,10 +103,8 @@ def optimize_group(settings: GroundContactPersonalizationSettings, feet: list[Fo
             raise InputError(f"GCP task {task.index or k} optimizes nothing", file=settings.settings_file,
                              line=task.source.line, element="<GCPTask>", expected="at least one design flag true")
         built = build_task_problem(feet, state, task, terms, name=f"gcp_task_{k}")
-        solution = solve_task(
-            built.problem, max_iterations=max_iterations or settings.max_iterations,
-            max_evaluations=settings.max_function_evaluations, ftol=settings.function_tolerance,
-            xtol=settings.step_tolerance, gtol=settings.optimality_tolerance, verbose=verbose)
+        solution = built.problem.solve("least_squares", verbose=2 if verbose else 0,
+                                       **solver_options(settings, max_iterations))
         if verbose:
             print(f"GCP task {k}: " + solution.summary())
         state = updated_state(state, solution, len(feet))

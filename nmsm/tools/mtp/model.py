@@ -14,8 +14,7 @@ Two SX functions per trial are ``map``-ped over the muscles: excitation -> activ
 (activation parameters; with SynX also synergy weights enter through the excitation
 samples) and (activation, normalized length, normalized velocity) -> tendon force.
 Normalized lengths, velocities and passive forces are plain MX elementwise expressions of
-the length scale factors. A problem may *lift* activations, lengths, velocities and
-moments (decision variables constrained to the modeled values,
+the length scale factors. A problem may *lift* activations, forces and moments (decision variables constrained to the modeled values,
 :func:`nmsm.tools.mtp.problem.build_task_problem`) so that exact Jacobians and Hessians
 stay sparse. Design quantities enter in their MTP units: electromechanical delay in
 0.1 s, activation time constant in 0.01 s.
@@ -83,9 +82,9 @@ def row(value: Any, n: int) -> cs.MX:
 class TrialModel:
     """Modeled quantities of one trial (CasADi MX).
 
-    ``activations`` / ``moments`` are what forces and costs use (lifted variables in an
-    optimization); ``modeled_activations`` / ``modeled_moments`` the model's values of
-    the same quantities.
+    ``activations``, ``tendon_force``, ``moments`` are what downstream quantities and
+    costs use (lifted variables in an optimization); ``modeled_*`` are the model's values
+    of the same quantities given their inputs.
     """
 
     name: str
@@ -100,6 +99,7 @@ class TrialModel:
     moments: cs.MX
     modeled_activations: cs.MX
     modeled_moments: cs.MX
+    modeled_tendon_force: cs.MX
 
 
 class TrialChain:
@@ -107,13 +107,23 @@ class TrialChain:
 
     ``stride``: the EMG spline goes through every ``stride``-th EMG sample (the original's
     Synergy Extrapolation path uses 4; see :class:`nmsm.tools.mtp.problem.MtpData`).
+    ``clip_smoothing``: width (-) of the smooth version of "negative neural activations set
+    to 0" (:func:`nmsm.model.hill.clip_negative`); 0 = the original's hard clip.
     """
 
-    def __init__(self, trial: TrialData, *, stride: int = 4, max_delay_variable: float = MAX_DELAY_VARIABLE) -> None:
+    def __init__(
+        self,
+        trial: TrialData,
+        *,
+        stride: int = 4,
+        clip_smoothing: float = 0.0,
+        max_delay_variable: float = MAX_DELAY_VARIABLE,
+    ) -> None:
         if trial.emg_time is None:
             raise ValueError(f"trial '{trial.name}' has no EMG")
         self.trial = trial
         self.stride = stride
+        self.clip_smoothing = float(clip_smoothing)
         t = np.asarray(trial.emg_time, dtype=float)
         self.n_emg = t.size
         self.sample_times = (t[-1] - t[0]) * np.linspace(0.0, 1.0, t.size) + t[0]
@@ -135,7 +145,7 @@ class TrialChain:
         e = sampler(delay / 10.0, coefs)
         neural_all = dynamics(e, tau / 100.0, self.dt)
         pad = self.padding
-        neural = cs.fmax(neural_all[pad : pad + n], 0)
+        neural = hill.clip_negative(neural_all[pad : pad + n], self.clip_smoothing)
         act = hill.activation_nonlinearity(neural, nonlin)
         activation = cs.Function(
             f"mtp_activation_{self.trial.name}",
@@ -210,15 +220,16 @@ class TrialChain:
     ) -> TrialModel:
         """Modeled quantities from undelayed excitation samples ``(n_emg, n_muscles)``.
 
-        ``lifted``: optional ``activations``, ``lengths``, ``velocities``, ``moments``
-        (decision variables constrained elsewhere to the modeled values) used in place of
-        the modeled ones downstream.
+        ``lifted``: optional ``activations``, ``forces``, ``moments`` (decision variables
+        constrained elsewhere to the modeled values) used in place of the modeled ones
+        downstream.
         """
         lifted = lifted or {}
         e, neural, act = self.activations(design, excitation_samples)
         lnorm, vnorm = self.fiber_kinematics(muscles, design, vmax_factor)
         a_used = lifted.get("activations", act)
-        force = self.tendon_forces(muscles, a_used, lifted.get("lengths", lnorm), lifted.get("velocities", vnorm))
+        modeled_force = self.tendon_forces(muscles, a_used, lnorm, vnorm)
+        force = lifted.get("forces", modeled_force)
         moments = joint_moments(self.trial.moment_arms, force)
         return TrialModel(
             name=self.trial.name,
@@ -233,6 +244,7 @@ class TrialChain:
             moments=lifted.get("moments", moments),
             modeled_activations=act,
             modeled_moments=moments,
+            modeled_tendon_force=modeled_force,
         )
 
 

@@ -47,6 +47,10 @@ BLOCKS: dict[str, tuple[float, float, float]] = {
     "tendon_slack_length_scale": (1.0, 0.6, 1.4),
 }
 SYNERGY_WEIGHT_BOUNDS = (-100.0, 100.0)
+#: smoothing of "negative neural activations set to 0" (see nmsm.model.hill.clip_negative);
+#: the original clips hard, which stalls IPOPT when synergy extrapolation drives
+#: excitations below 0; 1e-4 changes activations by at most 5e-5.
+DEFAULT_CLIP_SMOOTHING = 1e-4
 #: soft-maximum sharpness and limits of the normalized-fiber-length constraints
 CONSTRAINT_SHARPNESS = 500.0
 CONSTRAINT_MAX_LENGTH = 1.3
@@ -55,7 +59,13 @@ CONSTRAINT_MIN_LENGTH = 0.3
 
 @attrs.frozen(eq=False)
 class MtpData:
-    """Fixed inputs of MTP: muscles (base lengths), trials, channel map, groups, SynX."""
+    """Fixed inputs of MTP: muscles (base lengths), trials, channel map, groups, SynX.
+
+    ``stride``: EMG splines through every ``stride``-th sample. The original splines every
+    sample on its EMG-only path but every 4th on its SynX path; one stride for both keeps
+    the two paths consistent (zero SynX residuals give identical activations) and makes
+    the delayed spline 3 times cheaper. ``clip_smoothing``: see :data:`DEFAULT_CLIP_SMOOTHING`.
+    """
 
     muscles: MuscleParameters
     coordinates: tuple[str, ...]
@@ -66,6 +76,7 @@ class MtpData:
     synx: SynergyExtrapolation | None = None
     vmax_factor: float = 10.0
     stride: int = 4
+    clip_smoothing: float = DEFAULT_CLIP_SMOOTHING
 
     @property
     def missing(self) -> tuple[int, ...]:
@@ -80,7 +91,7 @@ class MtpData:
         return self.trials[0].padding
 
     def chains(self) -> list[TrialChain]:
-        return [TrialChain(t, stride=self.stride) for t in self.trials]
+        return [TrialChain(t, stride=self.stride, clip_smoothing=self.clip_smoothing) for t in self.trials]
 
     def expanded_emg(self) -> list[np.ndarray]:
         assert all(t.emg is not None for t in self.trials)
@@ -221,51 +232,39 @@ def build_task_problem(
 def _lift(
     problem: OptimizationProblem, data: MtpData, state: MtpState, chains: Sequence[TrialChain]
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]] | None]:
-    """Lifted variables per trial, started at the modeled values of ``state``.
+    """Lifted variables per trial (activations, tendon forces, moments) at ``state``'s values.
 
-    Activations and moments (and, shared by both, normalized fiber lengths and velocities)
-    become variables: then every constraint row depends on one muscle's parameters or on
-    one frame's values, so Jacobians and Hessians are cheap to compute and sparse.
+    Every lifting equality then depends on one muscle's parameters at one frame
+    (activations, forces) or on one frame's forces (moments, linear): exact Jacobians and
+    Hessians need few colours (see :mod:`nmsm.tools.mtp.derivatives`).
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
-    fields = ("activations", "normalized_fiber_length", "normalized_fiber_velocity", "moments")
+    fields = ("activations", "tendon_force", "moments")
     models = plain + (synx or [])
     values = cs.Function("lift_start", [], [getattr(m, f) for m in models for f in fields]).call([])
-    start = [[np.array(values[i * len(fields) + j].full()) for j in range(len(fields))] for i in range(len(models))]
-    lifted, lifted_synx = [], []
-    for k, model in enumerate(plain):
-        a, l, v, mom = start[k]
-        name = model.name
-        lifted.append({
-            "activations": problem.variable(f"activations_{name}", a, scale=1.0),
-            "lengths": problem.variable(f"normalized_fiber_lengths_{name}", l, scale=1.0),
-            "velocities": problem.variable(f"normalized_fiber_velocities_{name}", v, scale=1.0),
-            "moments": problem.variable(f"moments_{name}", mom, scale=np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)),
+    out: list[dict[str, Any]] = []
+    for i, model in enumerate(models):
+        a, force, mom = (np.array(values[i * len(fields) + j].full()) for j in range(len(fields)))
+        prefix = "" if i < len(plain) else "synx_"
+        force_scale = np.maximum(np.abs(force).max(axis=0), 1.0).reshape(1, -1)
+        moment_scale = np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)
+        out.append({
+            "activations": problem.variable(f"{prefix}activations_{model.name}", a, scale=1.0),
+            "forces": problem.variable(f"{prefix}tendon_forces_{model.name}", force, scale=force_scale),
+            "moments": problem.variable(f"{prefix}moments_{model.name}", mom, scale=moment_scale),
         })
-    if synx is None:
-        return lifted, None
-    for k, model in enumerate(synx):
-        a, _, _, mom = start[len(plain) + k]
-        lifted_synx.append({
-            "activations": problem.variable(f"synx_activations_{model.name}", a, scale=1.0),
-            "lengths": lifted[k]["lengths"],
-            "velocities": lifted[k]["velocities"],
-            "moments": problem.variable(f"synx_moments_{model.name}", mom, scale=np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)),
-        })
-    return lifted, lifted_synx
+    return out[: len(plain)], (out[len(plain) :] if synx is not None else None)
 
 
 def _lifting_constraints(problem: OptimizationProblem, models: Sequence[TrialModel],
                          lifted: Sequence[dict[str, Any]], prefix: str) -> None:
-    """Equalities tying lifted variables to the modeled quantities."""
+    """Equalities tying lifted variables to the modeled quantities (forces scaled to ~1)."""
     for model, values in zip(models, lifted):
         name = model.name
         problem.add_constraint(f"lifted_{prefix}activations_{name}", values["activations"] - model.modeled_activations, 0.0, 0.0)
+        problem.add_constraint(f"lifted_{prefix}forces_{name}", values["forces"] - model.modeled_tendon_force, 0.0, 0.0)
         problem.add_constraint(f"lifted_{prefix}moments_{name}", values["moments"] - model.modeled_moments, 0.0, 0.0)
-        if not prefix:
-            problem.add_constraint(f"lifted_lengths_{name}", values["lengths"] - model.normalized_fiber_length, 0.0, 0.0)
-            problem.add_constraint(f"lifted_velocities_{name}", values["velocities"] - model.normalized_fiber_velocity, 0.0, 0.0)
 
 
 def updated_state(state: MtpState, values: dict[str, np.ndarray]) -> MtpState:

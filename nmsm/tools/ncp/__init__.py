@@ -14,6 +14,8 @@ Modules (one job each):
 ``hessian``         exact structured Hessian handed to IPOPT
 ``loading``         settings -> :class:`NcpSetup` (model, groups, trials, MTP results)
 ``muscle_set``      muscles crossing coordinates; synergy groups from ForceSet groups
+``model_groups``    ForceSet group members of a model file (``nmsm vaf --group``)
+``symmetry``        mirror pairing of two groups' muscles (bilateral symmetry)
 ``outputs``         result files and ``read_solution`` (read synergies back)
 ``metrics``         moment / activation RMS of a solution
 ``table``           comparison table (ours vs the MATLAB original)

@@ -20,9 +20,9 @@ def _vaf(args: argparse.Namespace) -> int:
         members = group_members(args.model, args.group)
         if muscles is None:
             from nmsm.io.storage import read_storage
-            from nmsm.tools.ncp.vaf import _sto_files
+            from nmsm.tools.ncp.vaf import activation_files
 
-            available = set(read_storage(_sto_files(args.activations)[0]).labels)
+            available = set(read_storage(activation_files(args.activations)[0]).labels)
             muscles = [m for m in members if m in available]
             missing = [m for m in members if m not in available]
             if missing:

@@ -299,6 +299,12 @@ def hessian_function(problem: Any, inputs: NcpInputs, costs: Sequence[tuple[floa
     ``costs`` must list every cost entry of ``problem`` as ``(weight, residual builder)``;
     constraints must be linear (NCP's weight sums are).
     """
+    covered = sum(problem.variables[n].size for n in (*weight_vars, *node_vars))
+    if covered != problem.n_variables:
+        return None  # variables the structured form does not know
+    g = problem.constraint_vector()[0]
+    if g.numel() and cs.depends_on(cs.jacobian(g, problem.scaled_vector()), problem.scaled_vector()):
+        return None  # nonlinear constraints would add curvature
     quadratic = extract_quadratic(inputs, costs)
     if quadratic is None:
         return None

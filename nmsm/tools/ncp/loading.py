@@ -55,6 +55,9 @@ class NcpSetup:
     mtp_activation_files: tuple[Path, ...] | None
     dropped_coordinates: tuple[str, ...] = ()
     osimx_file: Path | None = None
+    #: muscles whose parameters MTLI replaced (those without MTP activations), and whether F0 was updated
+    mtli_muscles: tuple[str, ...] = ()
+    mtli_updated_force: bool = False
 
 
 def tracked_coordinates(settings: NeuralControlPersonalizationSettings, prefix: str) -> tuple[list[str], list[str]]:
@@ -278,7 +281,52 @@ def load_ncp(
         v_max_factor=settings.v_max_factor,
     )
     terms = tuple(build_terms(list(settings.cost_terms), "NCP"))
-    return NcpSetup(settings, model, inputs, terms, osimx, files, tuple(dropped), osimx_path)
+    mtli_muscles: tuple[str, ...] = ()
+    mtli = settings.muscle_tendon_length_initialization
+    if mtli.is_enabled:
+        inputs, mtli_muscles = _initialize_lengths(settings, inputs)
+    return NcpSetup(
+        settings, model, inputs, terms, osimx, files, tuple(dropped), osimx_path,
+        mtli_muscles=mtli_muscles, mtli_updated_force=bool(mtli_muscles) and mtli.optimize_isometric_max_force,
+    )
+
+
+def _passive_coordinates(directory: Path, coordinates: Sequence[str]) -> list[str]:
+    """Tracked coordinates with a column in the first passive trial's ID file."""
+    prefix = find_prefixes(directory)[0]
+    labels = set(read_storage(find_trial_file(directory / "IDData", prefix)).labels)
+    return [c for c in coordinates if {c, c + "_moment", c + "_force"} & labels]
+
+
+def _initialize_lengths(settings: NeuralControlPersonalizationSettings, inputs: NcpInputs) -> tuple[NcpInputs, tuple[str, ...]]:
+    """Run MTLI (tools.md §3) on the NCP muscles; keep its l_o, l_ts (F0) for muscles without MTP activations."""
+    from nmsm.tools.mtp.mtli import MtliOptions, load_passive_trials, run_mtli
+
+    mtli = settings.muscle_tendon_length_initialization
+    muscles = inputs.layout.muscles
+    passive = ()
+    if mtli.passive_data_input_directory is not None:
+        directory = Path(mtli.passive_data_input_directory)
+        passive = load_passive_trials(directory, _passive_coordinates(directory, inputs.coordinates), muscles)
+    options = MtliOptions(
+        max_normalized_fiber_length=mtli.max_normalized_muscle_fiber_length or 1.0,
+        min_normalized_fiber_length=mtli.min_normalized_muscle_fiber_length or 0.6,
+        optimize_maximum_muscle_stress=bool(mtli.optimize_maximum_muscle_stress),
+        update_max_isometric_force=mtli.optimize_isometric_max_force,
+        absolute_lengths=mtli.optimize_absolute_length_changes,
+        maximum_muscle_stress=mtli.maximum_muscle_stress,
+    )
+    terms = build_terms(list(mtli.cost_terms), "MTLI")
+    result = run_mtli(inputs.muscles, [t.lengths for t in inputs.trials], passive, inputs.fiber_length_groups, terms, options)
+    replace = np.array([i not in set(inputs.mtp_indices) for i in range(len(muscles))])
+    current, fitted = inputs.muscles, result.muscles
+    updated = attrs.evolve(
+        current,
+        optimal_fiber_length=np.where(replace, fitted.optimal_fiber_length, current.optimal_fiber_length),
+        tendon_slack_length=np.where(replace, fitted.tendon_slack_length, current.tendon_slack_length),
+        max_isometric_force=np.where(replace, fitted.max_isometric_force, current.max_isometric_force),
+    )
+    return attrs.evolve(inputs, muscles=updated), tuple(m for m, r in zip(muscles, replace) if r)
 
 
 def _load_labels(settings: NeuralControlPersonalizationSettings, prefix: str, coordinates: Sequence[str]) -> tuple[str, ...]:

@@ -19,7 +19,7 @@ Optimization for its initial guess).
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import attrs
@@ -32,7 +32,7 @@ from nmsm.io.trials import find_trial_file
 from nmsm.tools.ncp.forces import moment_gains
 from nmsm.tools.ncp.inputs import NcpInputs
 from nmsm.tools.ncp.solution import SynergySolution
-from nmsm.tools.ncp.synergies import SynergyLayout
+from nmsm.tools.ncp.synergies import SynergyGroup, SynergyLayout
 
 WEIGHTS_FILE = "synergyWeights.sto"
 COMMANDS_SUFFIX = "_synergyCommands.sto"
@@ -123,25 +123,28 @@ def ncp_osimx(
     associated_model: str,
     inputs: NcpInputs,
     *,
+    mtli_muscles: Sequence[str] = (),
     updated_max_isometric_force: Sequence[str] = (),
 ) -> OsimxModel:
     """The output ``.osimx`` content (see module docstring).
 
     Muscle entries of the input are kept; NCP muscles lacking ``optimal_fiber_length`` /
-    ``tendon_slack_length`` get the values NCP used (``max_isometric_force`` too for the
-    muscles in ``updated_max_isometric_force``, e.g. updated by MTLI). The synergy set lists
-    the NCP synergy groups (replacing groups of the same name, keeping others).
+    ``tendon_slack_length`` get the values NCP used, and so do the ``mtli_muscles`` (whose
+    lengths MTLI set); ``max_isometric_force`` is written for the muscles in
+    ``updated_max_isometric_force``. The synergy set lists the NCP synergy groups
+    (replacing groups of the same name, keeping others).
     """
     base = input_osimx or OsimxModel(name=model_name, associated_osim_model=associated_model)
     muscles = dict(base.muscles)
     params = inputs.muscles
     forced = set(updated_max_isometric_force)
+    initialized = set(mtli_muscles)
     for i, name in enumerate(params.names):
         current = muscles.get(name, OsimxMuscle(name=name))
         changes = {}
-        if current.optimal_fiber_length is None:
+        if current.optimal_fiber_length is None or name in initialized:
             changes["optimal_fiber_length"] = float(params.optimal_fiber_length[i])
-        if current.tendon_slack_length is None:
+        if current.tendon_slack_length is None or name in initialized:
             changes["tendon_slack_length"] = float(params.tendon_slack_length[i])
         if name in forced:
             changes["max_isometric_force"] = float(params.max_isometric_force[i])
@@ -163,6 +166,34 @@ def relative_model_path(model_file: Path, results_directory: Path) -> str:
         return os.path.relpath(Path(model_file).resolve(), Path(results_directory).resolve())
     except ValueError:  # different drives on Windows
         return str(Path(model_file).resolve())
+
+
+def layout_from_groups(
+    model_groups: Mapping[str, Sequence[str]],
+    synergies: Sequence[tuple[str, int]],
+    muscles: Sequence[str],
+    *,
+    source: str | os.PathLike[str] | None = None,
+) -> SynergyLayout:
+    """The layout of synergy groups ``(ForceSet group, number of synergies)`` restricted to ``muscles``.
+
+    ``muscles`` are the columns of a ``synergyWeights.sto`` (the muscles NCP modeled); each
+    group keeps its ForceSet members that are among them, in group order. Used by
+    Treatment Optimization with the model's groups and the ``.osimx`` RCNLSynergySet.
+    """
+    available = set(muscles)
+    groups = []
+    for name, count in synergies:
+        if name not in model_groups:
+            raise InputError(
+                f"synergy group '{name}' is not a ForceSet group of the model",
+                file=source,
+                element="<RCNLSynergy>/<muscle_group_name>",
+                expected="one of the model's groups: " + ", ".join(sorted(model_groups)),
+            )
+        members = [m for m in model_groups[name] if m in available]
+        groups.append(SynergyGroup(name, members, count))
+    return SynergyLayout(groups)
 
 
 def read_solution(results_directory: str | os.PathLike[str], layout: SynergyLayout, trial_names: Sequence[str]) -> SynergySolution:

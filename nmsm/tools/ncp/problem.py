@@ -7,7 +7,8 @@ Design variables (all >= 0, no upper bounds; tools.md §5):
 * ``nodes_<trial>`` (N, S): command spline nodes of every synergy in the trial.
 
 Activations ``a_t = (B @ nodes_t) @ W`` are bilinear in the variables and moments linear in
-activations, so the objective is a polynomial whose exact Hessian CasADi forms cheaply.
+activations, so the objective is a quartic polynomial; its exact Hessian is assembled from
+that structure (:meth:`NcpProblem.ipopt_options`, :mod:`nmsm.tools.ncp.hessian`).
 Each free group's vectors sum to ``M_g/100`` (:class:`SynergyWeightSum`).
 
 Proximal term: with the settings' terms alone the activations can be undetermined (e.g.
@@ -15,8 +16,9 @@ moment tracking only: infinitely many synergy sets give the same moments) and an
 optimizer then drifts anywhere along that set. ``proximal_weight`` (default
 :data:`PROXIMAL_WEIGHT`) adds ``w * mean((a - a_start)**2)`` over all activations, pulling
 toward the starting activations (the NMF of the MTP activations). It selects a solution
-where the settings' terms are flat and is negligible elsewhere; it is reported as its
-own entry (``proximal:start_activations``) and never counted in NCP's cost. Use 0 to drop it.
+where the settings' terms are flat and is negligible elsewhere (w = 0.1 is a term with
+``max_allowable_error`` ≈ 3.2 activation units); it is reported as its own entry
+(``proximal:start_activations``) and never counted in NCP's cost. Use 0 to drop it.
 """
 
 from __future__ import annotations

@@ -1,18 +1,25 @@
 """``nmsm run`` for ``<NeuralControlPersonalizationTool>``: read, optimize, write.
 
 :func:`run_settings` reads the settings (older schemas upgraded), loads the model and
-data (:mod:`nmsm.tools.ncp.loading`), builds the problem (:mod:`nmsm.tools.ncp.problem`)
-from the NMF start (:mod:`nmsm.tools.ncp.initial_guess`), solves it with IPOPT (exact
-derivatives), normalizes the synergies (largest weight one) and writes the results
+data (:mod:`nmsm.tools.ncp.loading`; MTLI first when enabled), builds the problem
+(:mod:`nmsm.tools.ncp.problem`) from the NMF start (:mod:`nmsm.tools.ncp.initial_guess`),
+solves it with IPOPT (exact gradient and Hessian, :mod:`nmsm.tools.ncp.hessian`),
+normalizes the synergies (largest weight one) and writes the results
 (:mod:`nmsm.tools.ncp.outputs`) through a staging folder, together with a copy of the
-settings file and ``commandWindowOutput.txt`` (solver summary, costs, fit metrics).
+settings file, ``commandWindowOutput.txt`` (solver summary, costs, fit metrics) and
+``ncpRunInfo.json`` (inputs used, for the plots).
+
+Solver settings: the settings' ``max_iterations`` is IPOPT's ``max_iter``; IPOPT ``tol``
+1e-8 (the fmincon tolerances of the settings file do not translate and are not used).
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import stat
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +27,7 @@ import attrs
 
 from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
-from nmsm.errors import SolverError
+from nmsm.errors import InputError, SolverError
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
 from nmsm.tools.ncp.initial_guess import initial_guess
@@ -37,7 +44,7 @@ from nmsm.tools.ncp.outputs import (
     write_run_info,
     write_trial_files,
 )
-from nmsm.tools.ncp.problem import build_problem, score
+from nmsm.tools.ncp.problem import PROXIMAL_WEIGHT, build_problem, score
 from nmsm.tools.ncp.solution import SynergySolution
 
 #: log written into the results folder, as the original's
@@ -74,14 +81,23 @@ def _ipopt_options(settings: NeuralControlPersonalizationSettings, overrides: di
     return options
 
 
-def solve(setup: NcpSetup, **ipopt_options: Any) -> tuple[SynergySolution, Solution]:
-    """Optimize the synergies of ``setup``; returns the (not normalized) solution and the solver result."""
+def solve(setup: NcpSetup, *, proximal_weight: float = PROXIMAL_WEIGHT, **ipopt_options: Any) -> tuple[SynergySolution, Solution]:
+    """Optimize the synergies of ``setup``; returns the (not normalized) solution and the solver result.
+
+    ``proximal_weight``: see :mod:`nmsm.tools.ncp.problem`; other options go to the IPOPT back end.
+    """
     guess = initial_guess(setup.inputs)
-    built = build_problem(setup.inputs, setup.terms, guess)
-    options = {**built.ipopt_options(), **ipopt_options}
+    built = build_problem(setup.inputs, setup.terms, guess, proximal_weight=proximal_weight)
+    structured = built.ipopt_options()
+    options = {**structured, **ipopt_options}
+    if "casadi_options" in ipopt_options and "casadi_options" in structured:
+        options["casadi_options"] = {**structured["casadi_options"], **ipopt_options["casadi_options"]}
     solved = built.problem.solve("ipopt", **options)
     if not solved.success and "Maximum_Iterations" not in solved.status and "Acceptable" not in solved.status:
         raise SolverError(f"NCP optimization failed: IPOPT status {solved.status} after {solved.iterations} iterations")
+    if not solved.success:
+        warnings.warn(f"NCP: IPOPT stopped with status {solved.status} after {solved.iterations} iterations; "
+                      "results written from the last iterate", stacklevel=2)
     return built.solution(solved), solved
 
 
@@ -103,9 +119,30 @@ def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metric
         f"activation RMS vs MTP (pooled): {metrics.activation_rms_pooled:.5f}; VAF {100 * metrics.activation_vaf:.2f} %",
         f"wall time {wall:.1f} s",
     ]
+    if setup.mtli_muscles:
+        lines.append("muscle-tendon length initialization updated: " + ", ".join(setup.mtli_muscles))
     if setup.dropped_coordinates:
         lines.append("coordinates without ID data (not tracked): " + ", ".join(setup.dropped_coordinates))
     return "\n".join(lines) + "\n"
+
+
+def _check_writable(folder: Path, settings_file: Path) -> None:
+    """Fail before optimizing when the results folder cannot (or must not) be written.
+
+    A folder without any write permission bit counts as read-only even for a user who
+    could override it (root): input data folders are marked that way.
+    """
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    marked_read_only = stat.S_IMODE(existing.stat().st_mode) & 0o222 == 0
+    if marked_read_only or not os.access(existing, os.W_OK):
+        raise InputError(
+            f"results folder {folder} cannot be written ({existing} is read-only)",
+            file=settings_file,
+            element="<results_directory>",
+            expected="a writable folder (or pass results_directory=... / another settings file)",
+        )
 
 
 def run_settings(
@@ -116,23 +153,26 @@ def run_settings(
     max_iterations: int | None = None,
     tolerance: float | None = None,
     print_level: int | None = None,
+    proximal_weight: float = PROXIMAL_WEIGHT,
     plots: bool = False,
     **ipopt: Any,
 ) -> NcpRun:
     """Run NCP as the settings file ``path`` says.
 
     Options override the settings: ``results_directory``, ``enforce_bilateral_symmetry``,
-    ``max_iterations``, ``tolerance`` (IPOPT ``tol``), ``print_level`` (IPOPT output, 0 quiet);
-    other keyword arguments go to the IPOPT back end. ``plots=True`` also saves the NCP
+    ``max_iterations``, ``tolerance`` (IPOPT ``tol``), ``print_level`` (IPOPT output, 0 quiet),
+    ``proximal_weight`` (pull toward the start where the terms leave activations free, see
+    :mod:`nmsm.tools.ncp.problem`); other keyword arguments go to the IPOPT back end. ``plots=True`` also saves the NCP
     figures (:func:`nmsm.plots.ncp.plot_ncp_results`) into ``<results>/plots``.
     """
     start = time.perf_counter()
     settings = read_settings(path)
     if results_directory is not None:
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
+    _check_writable(Path(settings.results_directory), settings.settings_file)
     setup = load_ncp(settings, enforce_bilateral_symmetry=enforce_bilateral_symmetry)
     options = _ipopt_options(settings, {"max_iter": max_iterations, "tol": tolerance, "print_level": print_level, **ipopt})
-    raw, solved = solve(setup, **options)
+    raw, solved = solve(setup, proximal_weight=proximal_weight, **options)
     solution = raw.normalized()
     costs = score(setup.inputs, setup.terms, solution)
     metrics = fit_metrics(setup.inputs, solution)
@@ -151,6 +191,8 @@ def run_settings(
             setup.model.name,
             relative_model_path(Path(settings.input_model_file), out_dir),
             setup.inputs,
+            mtli_muscles=setup.mtli_muscles,
+            updated_max_isometric_force=setup.mtli_muscles if setup.mtli_updated_force else (),
         )
         write_ncp_osimx(stage / osimx_name, osimx)
         write_run_info(stage / RUN_INFO_FILE, setup)

@@ -79,7 +79,8 @@ def vaf_curve(
     return VafCurve(muscles=names, counts=counts, vaf=values, name=name)
 
 
-def _sto_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
+def activation_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
+    """``.sto``/``.mot`` files named by ``paths`` (files, or folders whose tables are taken in name order)."""
     files: list[Path] = []
     for raw in paths:
         path = Path(raw)
@@ -105,7 +106,7 @@ def read_activation_trials(
     """
     from nmsm.io.storage import read_storage
 
-    files = _sto_files(paths)
+    files = activation_files(paths)
     blocks = []
     names: tuple[str, ...] | None = tuple(muscles) if muscles is not None else None
     for path in files:

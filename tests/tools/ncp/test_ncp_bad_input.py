@@ -86,3 +86,15 @@ def test_results_next_to_the_settings_keep_the_settings_file(case) -> None:
     run = run_settings(case.settings_file, results_directory=case.folder, print_level=0)
     assert run.results_directory == case.folder and (case.folder / "synergyWeights.sto").is_file()
     assert case.settings_file.read_bytes() == before
+
+
+def test_read_only_results_folder_is_refused_before_optimizing(case, tmp_path) -> None:
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        with pytest.raises(InputError, match="<results_directory>: results folder .* cannot be written"):
+            run_settings(case.settings_file, results_directory=locked / "out", print_level=0)
+        assert not any(locked.iterdir())
+    finally:
+        locked.chmod(0o755)

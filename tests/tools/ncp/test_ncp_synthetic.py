@@ -60,3 +60,54 @@ def test_dispatcher_runs_ncp_settings(tmp_path) -> None:
     again = run_settings_file(result.case.settings_file, results_directory=tmp_path / "b", print_level=0)
     assert (tmp_path / "b" / "synergyWeights.sto").is_file()
     assert again.costs["total"] == pytest.approx(result.run.costs["total"], rel=1e-6)
+
+
+def test_nmsm_run_command(tmp_path) -> None:
+    from nmsm.cli import main
+    from nmsm.examples.synthetic_ncp import make_synthetic_ncp_case
+
+    case = make_synthetic_ncp_case(tmp_path, n_trials=1, n_points=41)
+    assert main(["run", str(case.settings_file)]) == 0
+    assert (case.folder / "results" / "trial_1_synergyCommands.sto").is_file()
+
+
+def test_results_read_back_for_treatment_optimization(tmp_path) -> None:
+    from nmsm.model import load_model
+    from nmsm.tools.ncp.outputs import layout_from_groups, read_solution
+
+    result = run_synthetic_ncp(tmp_path)
+    folder = result.case.folder / "results"
+    osimx = read_osimx(folder / "legs_mtp_ncp.osimx")
+    weights = read_storage(folder / "synergyWeights.sto")
+    layout = layout_from_groups(load_model(result.case.model_file).groups,
+                                [(s.muscle_group_name, s.num_synergies) for s in osimx.synergies], weights.labels)
+    solution = read_solution(folder, layout, result.case.trials)
+    for t in range(len(result.case.trials)):
+        assert np.allclose(solution.activations(t), result.run.solution.activations(t), atol=1e-12)
+
+
+def test_without_mtp_activations(tmp_path) -> None:
+    """No MTP results: activation minimization covers every muscle; moments are still tracked."""
+    from lxml import etree
+
+    from nmsm.examples.synthetic_ncp import make_synthetic_ncp_case
+    from nmsm.tools.ncp.run import run_settings
+
+    case = make_synthetic_ncp_case(tmp_path, n_trials=1, n_points=51)
+    tree = etree.parse(str(case.settings_file))
+    tool = tree.getroot().find("NeuralControlPersonalizationTool")
+    tool.find("mtp_results_directory").text = ""
+    terms = tool.find("RCNLCostTermSet")
+    for term in terms.findall("RCNLCostTerm"):
+        if term.findtext("type") == "activation_tracking":
+            term.find("type").text = "activation_minimization"
+            term.find("max_allowable_error").text = "1"
+    tree.write(str(case.settings_file))
+    run = run_settings(case.settings_file, print_level=0)
+    assert run.solver.success and not run.setup.inputs.mtp_muscles
+    assert run.setup.mtp_activation_files is None
+    assert np.isnan(run.metrics.activation_rms_pooled)
+    peak = np.abs(case.true_moments[0]).max()
+    assert run.metrics.moment_rms.max() < 0.02 * peak
+    combined = read_storage(case.folder / "results" / "trial_1_combinedActivations.sto")
+    assert np.allclose(combined.columns(list(run.solution.layout.muscles)), run.solution.activations(0))

@@ -1,0 +1,319 @@
+"""Muscle-Tendon Personalization from a settings file: ``run_settings(path, **options)``.
+
+Steps (the original's ``MuscleTendonPersonalizationTool``):
+
+1. read settings, model (+ input ``.osimx``), trials (ID, MA, EMG) of the muscles
+   crossing ``coordinate_list``;
+2. Muscle-Tendon Length Initialization when enabled (new l_o, l_ts, F0);
+3. each enabled MTP task in index order (IPOPT, exact derivatives); after a task the
+   length scale factors are absorbed into l_o, l_ts;
+4. results written per §4.6 (:mod:`nmsm.tools.mtp.outputs`), staged, plus the settings file.
+
+``options``: ``results_directory`` (write elsewhere than the settings say),
+``print_level`` (IPOPT, default 0), ``max_iterations`` (override), ``tolerance`` (IPOPT
+``tol``, default 1e-6), ``emg_spline_stride`` (default 4), ``verbose`` (progress lines).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import attrs
+import numpy as np
+
+from nmsm.core.results import ResultsDirectory
+from nmsm.core.term import CostTerm, build_terms
+from nmsm.errors import InputError, SolverError
+from nmsm.io.osimx import OsimxModel, read_osimx
+from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
+from nmsm.tools.mtp import outputs
+from nmsm.tools.mtp.data import TrialData, check_same_frame_counts, find_prefixes, load_trial
+from nmsm.tools.mtp.derivatives import blockwise_derivatives
+from nmsm.tools.mtp.evaluation import ModeledValues, evaluate, initial_fiber_lengths
+from nmsm.tools.mtp.model_info import muscle_parameters, muscles_crossing
+from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, passive_moments_at, run_mtli
+from nmsm.tools.mtp.mtli_model import PassiveTrial
+from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters, channel_map, resolve_groups
+from nmsm.tools.mtp.problem import (
+    BLOCKS,
+    MtpData,
+    MtpState,
+    TaskSettings,
+    absorb_length_scales,
+    build_task_problem,
+    updated_state,
+)
+from nmsm.tools.mtp.synx import build_synergy_extrapolation
+
+#: settings flag -> design block
+TASK_FLAGS = {
+    "optimize_electromechanical_delays": "electromechanical_delay",
+    "optimize_activation_time_constants": "activation_time_constant",
+    "optimize_activation_nonlinearity_constants": "activation_nonlinearity",
+    "optimize_emg_scale_factors": "emg_scale",
+    "optimize_optimal_fiber_lengths": "optimal_fiber_length_scale",
+    "optimize_tendon_slack_lengths": "tendon_slack_length_scale",
+}
+
+
+@attrs.frozen(eq=False)
+class MtpSetup:
+    """Everything read from the settings, model and data, before any optimization."""
+
+    settings: MuscleTendonPersonalizationSettings
+    model_name: str
+    input_osimx: OsimxModel | None
+    model_muscles: MuscleParameters
+    data: MtpData
+    passive_trials: tuple[PassiveTrial, ...]
+    tasks: tuple[TaskSettings, ...]
+    mtli_terms: tuple[CostTerm, ...]
+
+
+@attrs.frozen(eq=False)
+class TaskOutcome:
+    index: int
+    cost: float
+    term_costs: dict[str, float]
+    status: str
+    iterations: int
+    wall_time: float
+
+
+@attrs.frozen(eq=False)
+class MtpOutcome:
+    """Final parameters, modeled values and where results went.
+
+    ``start_data``: the data the first task started from (muscles after MTLI);
+    ``data``: with the final l_o, l_ts (scale factors absorbed, ``state`` scales are 1).
+    """
+
+    setup: MtpSetup
+    start_data: MtpData
+    data: MtpData
+    state: MtpState
+    mtli: MtliResult | None
+    tasks: tuple[TaskOutcome, ...]
+    plain: ModeledValues
+    synx: ModeledValues | None
+    results_directory: Path
+    wall_time: float
+
+    @property
+    def final_muscles(self) -> MuscleParameters:
+        return self.data.muscles
+
+
+def _log(verbose: bool, message: str) -> None:
+    if verbose:
+        print(f"[mtp] {message}", file=sys.stderr, flush=True)
+
+
+def task_settings(task: MtpTask, synx_terms: Sequence[CostTerm]) -> TaskSettings:
+    terms = tuple(t for t in build_terms(list(task.cost_terms), "MTP") if isinstance(t, CostTerm))
+    return TaskSettings(
+        optimize={block: bool(getattr(task, flag)) for flag, block in TASK_FLAGS.items()},
+        cost_terms=terms,
+        synx_terms=tuple(synx_terms),
+        min_normalized_fiber_length=task.min_normalized_muscle_fiber_length,
+        max_normalized_fiber_length=task.max_normalized_muscle_fiber_length,
+    )
+
+
+def prepare(settings_file: str | os.PathLike[str], *, emg_spline_stride: int = 4) -> MtpSetup:
+    """Read settings, model, osimx and data; validate names and shapes."""
+    from nmsm.model import load_model
+
+    doc = read_settings_document(settings_file)
+    settings = MuscleTendonPersonalizationSettings.from_document(doc)
+    if not settings.tasks:
+        raise InputError("no enabled <MTPTask>", file=settings_file, element="<MTPTaskList>",
+                         expected="at least one task with <is_enabled>true</is_enabled>")
+    model = load_model(settings.input_model_file)
+    osimx = read_osimx(settings.input_osimx_file) if settings.input_osimx_file else None
+    coordinates = tuple(settings.coordinate_list)
+    names = muscles_crossing(model, coordinates)
+    muscles = muscle_parameters(model, names, osimx)
+    model_file = str(settings.input_model_file)
+    groups = model.groups
+    collected = resolve_groups(settings.collected_emg_channel_muscle_groups, groups, names,
+                               setting="collected_emg_channel_muscle_groups", model_file=model_file, drop_empty=False)
+    synx_settings = settings.synergy_extrapolation
+    missing = resolve_groups(settings.missing_emg_channel_muscle_groups, groups, names,
+                             setting="missing_emg_channel_muscle_groups", model_file=model_file)
+    channels = channel_map(names, collected, missing)
+    if missing and not synx_settings.is_enabled:
+        warnings.warn(
+            "synergy extrapolation is off: muscles of <missing_emg_channel_muscle_groups> ("
+            + ", ".join(names[i] for g in missing for i in g.indices) + ") get zero excitation",
+            stacklevel=2,
+        )
+    activation_groups = resolve_groups(settings.activation_muscle_groups, groups, names,
+                                       setting="activation_muscle_groups", model_file=model_file)
+    fiber_groups = resolve_groups(settings.normalized_fiber_length_muscle_groups, groups, names,
+                                  setting="normalized_fiber_length_muscle_groups", model_file=model_file)
+    prefixes = find_prefixes(settings.data_directory, settings.trial_prefixes)
+    channel_names = [g.name for g in collected]
+    trials = tuple(load_trial(settings.data_directory, p, coordinates, names, channel_names) for p in prefixes)
+    check_same_frame_counts(trials)
+    synx = None
+    if synx_settings.is_enabled:
+        synx = build_synergy_extrapolation(
+            [t.emg for t in trials],
+            [t.name for t in trials],
+            method=synx_settings.matrix_factorization_method,
+            n_synergies=int(synx_settings.number_of_synergies),
+            extrapolation_categorization=str(synx_settings.synergy_extrapolation_categorization),
+            residual_categorization=str(synx_settings.residual_categorization),
+            missing_muscles=[g.indices for g in missing],
+            channel_muscles=[g.indices for g in collected],
+        )
+    data = MtpData(muscles, coordinates, trials, channels, activation_groups, fiber_groups, synx,
+                   float(settings.v_max_factor), int(emg_spline_stride))
+    synx_terms = tuple(t for t in build_terms(list(synx_settings.cost_terms), "SynX") if isinstance(t, CostTerm)) \
+        if synx_settings.is_enabled else ()
+    tasks = tuple(task_settings(t, synx_terms) for t in settings.tasks)
+    mtli = settings.muscle_tendon_length_initialization
+    passive: tuple[PassiveTrial, ...] = ()
+    mtli_terms: tuple[CostTerm, ...] = ()
+    if mtli.is_enabled:
+        mtli_terms = tuple(t for t in build_terms(list(mtli.cost_terms), "MTLI") if isinstance(t, CostTerm))
+        if mtli.passive_data_input_directory is not None:
+            passive = load_passive_trials(mtli.passive_data_input_directory, coordinates, names)
+    return MtpSetup(settings, model.name, osimx, muscles, data, passive, tasks, mtli_terms)
+
+
+def mtli_options(setup: MtpSetup) -> MtliOptions:
+    m = setup.settings.muscle_tendon_length_initialization
+    return MtliOptions(
+        max_normalized_fiber_length=m.max_normalized_muscle_fiber_length if m.max_normalized_muscle_fiber_length is not None else 1.0,
+        min_normalized_fiber_length=m.min_normalized_muscle_fiber_length if m.min_normalized_muscle_fiber_length is not None else 0.6,
+        optimize_maximum_muscle_stress=bool(m.optimize_maximum_muscle_stress),
+        update_max_isometric_force=bool(m.optimize_isometric_max_force),
+        absolute_lengths=bool(m.optimize_absolute_length_changes),
+        maximum_muscle_stress=float(m.maximum_muscle_stress),
+    )
+
+
+def initialize_lengths(setup: MtpSetup) -> tuple[MtpData, MtliResult | None]:
+    """Run MTLI if enabled; the data's muscles then carry the new l_o, l_ts, F0."""
+    if not setup.settings.muscle_tendon_length_initialization.is_enabled:
+        return setup.data, None
+    gait = [t.muscle_tendon_length for t in setup.data.trials]
+    result = run_mtli(setup.data.muscles, gait, setup.passive_trials, setup.data.fiber_length_groups,
+                      setup.mtli_terms, mtli_options(setup))
+    return attrs.evolve(setup.data, muscles=result.muscles), result
+
+
+def solve_tasks(
+    setup: MtpSetup,
+    data: MtpData,
+    *,
+    state: MtpState | None = None,
+    print_level: int = 0,
+    max_iterations: int | None = None,
+    tolerance: float = 1e-6,
+    verbose: bool = False,
+    on_task: Any = None,
+) -> tuple[MtpData, MtpState, list[TaskOutcome]]:
+    """Run every task in order from ``state`` (default: the original's initial values)."""
+    state = state or MtpState.initial(data)
+    initial_lengths = initial_fiber_lengths(data)
+    outcomes = []
+    for k, task in enumerate(setup.tasks, start=1):
+        _log(verbose, f"task {k}: building the problem")
+        problem, _ = build_task_problem(data, state, task, initial_lengths, name=f"MTP_task_{k}")
+        _log(verbose, f"task {k}: {problem.n_variables} variables; solving with IPOPT")
+        solution = problem.solve(
+            "ipopt",
+            max_iter=int(max_iterations if max_iterations is not None else setup.settings.max_iterations),
+            tol=tolerance,
+            print_level=print_level,
+            casadi_options=blockwise_derivatives(problem),
+        )
+        if not all(np.all(np.isfinite(v)) for v in solution.values.values()):
+            raise SolverError(f"MTP task {k} returned non-finite values ({solution.status})")
+        if not solution.success:
+            warnings.warn(f"MTP task {k}: IPOPT ended with '{solution.status}'; using its last iterate", stacklevel=2)
+        state = updated_state(state, solution.values)
+        outcome = TaskOutcome(k, solution.cost, dict(solution.term_costs), solution.status, solution.iterations,
+                              solution.wall_time)
+        outcomes.append(outcome)
+        _log(verbose, f"task {k}: {solution.status}, cost {solution.cost:.6g}, {solution.iterations} iterations, "
+                      f"{solution.wall_time:.1f} s")
+        if on_task is not None:
+            on_task(k, data, state, outcome)
+        data, state = absorb_length_scales(data, state)
+    return data, state, outcomes
+
+
+def output_osimx_name(setup: MtpSetup) -> str:
+    base = Path(setup.settings.input_osimx_file).stem if setup.settings.input_osimx_file else \
+        Path(setup.settings.input_model_file).stem
+    return f"{base}_mtp.osimx"
+
+
+def write_results(outcome: MtpOutcome, results: ResultsDirectory) -> None:
+    setup = outcome.setup
+    trial_times = [t.time for t in outcome.data.trials]
+    with results.task("mtp_results") as stage:
+        outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)
+        outputs.parameter_file(stage, outcome.state, outcome.final_muscles, setup.model_muscles)
+        if setup.passive_trials:
+            modeled = passive_moments_at(outcome.final_muscles, setup.passive_trials)
+            outputs.passive_moment_files(stage, outcome.data.coordinates, setup.passive_trials, modeled)
+        outputs.osimx_file(
+            stage,
+            output_osimx_name(setup),
+            setup.model_name,
+            str(setup.settings.input_model_file),
+            outcome.state,
+            outcome.final_muscles,
+            write_max_isometric_force=outcome.mtli is not None and mtli_options(setup).update_max_isometric_force,
+            base=setup.input_osimx,
+        )
+        lines = [f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; {t.wall_time:.2f} s"
+                 for t in outcome.tasks]
+        for t in outcome.tasks:
+            lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
+        lines.append(f"total wall time: {outcome.wall_time:.2f} s")
+        (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n")
+
+
+def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOutcome:
+    """Run MTP (and MTLI) from ``settings_file``; see the module docstring for ``options``."""
+    start = time.perf_counter()
+    verbose = bool(options.pop("verbose", False))
+    results_dir = options.pop("results_directory", None)
+    stride = int(options.pop("emg_spline_stride", 4))
+    print_level = int(options.pop("print_level", 0))
+    max_iterations = options.pop("max_iterations", None)
+    tolerance = float(options.pop("tolerance", 1e-6))
+    if options:
+        raise TypeError(f"unknown MTP options: {', '.join(options)}")
+    setup = prepare(settings_file, emg_spline_stride=stride)
+    target = Path(results_dir) if results_dir is not None else Path(setup.settings.results_directory)
+    inputs = [setup.settings.input_model_file, settings_file]
+    if setup.settings.input_osimx_file:
+        inputs.append(setup.settings.input_osimx_file)
+    results = ResultsDirectory(target, inputs=inputs)
+    _log(verbose, f"{len(setup.data.trials)} trials, {setup.data.muscles.n_muscles} muscles, "
+                  f"{len(setup.data.coordinates)} coordinates, SynX {'on' if setup.data.synx else 'off'}")
+    start_data, mtli = initialize_lengths(setup)
+    if mtli is not None:
+        _log(verbose, f"MTLI: {mtli.solution.status}, cost {mtli.solution.cost:.6g}")
+    data, state, tasks = solve_tasks(setup, start_data, print_level=print_level, max_iterations=max_iterations,
+                                     tolerance=tolerance, verbose=verbose)
+    plain, synx = evaluate(data, state)
+    outcome = MtpOutcome(setup, start_data, data, state, mtli, tuple(tasks), plain, synx, results.path,
+                         time.perf_counter() - start)
+    write_results(outcome, results)
+    results.copy_in(settings_file, Path(settings_file).name)
+    return outcome
