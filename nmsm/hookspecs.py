@@ -47,5 +47,9 @@ class NmsmHookSpecs:
         """Return :class:`nmsm.core.plugin_bases.Controller` subclasses (torque, synergy, ...)."""
 
     @hookspec
+    def nmsm_contact_models(self) -> list[type]:
+        """Return :class:`nmsm.core.plugin_bases.ContactModel` subclasses (ground contact in TO/VO/DO)."""
+
+    @hookspec
     def nmsm_model_modifiers(self) -> list[type]:
         """Return :class:`nmsm.core.plugin_bases.ModelModifier` subclasses (Design Optimization ``model_functions``)."""

@@ -6,7 +6,7 @@ it takes to register it.
 
 from __future__ import annotations
 
-from nmsm.core.plugin_bases import Controller
+from nmsm.core.plugin_bases import ContactModel, Controller
 from nmsm.core.registry import classes_in_package
 from nmsm.hookspecs import hookimpl
 
@@ -14,3 +14,8 @@ from nmsm.hookspecs import hookimpl
 @hookimpl
 def nmsm_controllers() -> list[type]:
     return classes_in_package(__name__, Controller)
+
+
+@hookimpl
+def nmsm_contact_models() -> list[type]:
+    return classes_in_package(__name__ + ".contact", ContactModel)

@@ -14,7 +14,11 @@ surrogate coordinates.
 Normalization (``synergy_vector_normalization_method``): ``sum`` - each vector row is
 divided by (row sum / value) and its commands multiplied by the same; ``magnitude`` - by
 (norm / value); ``none``. Applied to the initial weights and commands before the solve and to
-the solution before writing (activations unchanged).
+the solution before writing (activations unchanged). With ``optimize_synergy_vectors`` the
+normalization is also a constraint of the problem (each vector's sum, or norm, equals the
+value): activations ``C W`` are unchanged by rescaling a synergy's commands and vector, and
+fixing that scale removes a flat direction that slows IPOPT down (the original leaves it free
+and normalizes afterwards; the optimal activations are the same).
 
 Initial guess (required): ``<trial>_synergyCommands.sto`` (columns ``<group>_<k>``) and
 ``synergyWeights.sto`` in the initial guess directory. Outputs:
@@ -192,6 +196,13 @@ class SynergyController(Controller):
         for k, (i, j) in enumerate(idx):
             W[int(i), int(j)] = values[k]
         self._weights_expr = W
+        # gauge: A = C W is unchanged by (C a, W / a), which leaves IPOPT a flat direction per
+        # synergy; fixing each vector's norm as the output normalization will (sum or
+        # magnitude = value) removes it without changing the optimal activations
+        if self.method == "sum":
+            problem.add_constraint("synergy_vector_normalization", cs.sum2(W) - self.norm_value, 0.0, 0.0)
+        elif self.method == "magnitude":
+            problem.add_constraint("synergy_vector_normalization", cs.sum2(W**2) - self.norm_value**2, 0.0, 0.0)
 
     def controlled_coordinates(self) -> tuple[str, ...]:
         return self.coordinates

@@ -121,6 +121,44 @@ class Controller:
         return {}
 
 
+class ContactModel:
+    """Ground contact in Treatment Optimization: loads on bodies from the kinematics.
+
+    ``discover(setup)`` returns the instances a problem has (from the model or the
+    ``.osimx``; none when it has no such contact). Each instance names a surface and its
+    ground-reaction column labels (``force_labels``, ``moment_labels``, ``point_labels``:
+    x, y, z), lists ``load_bodies`` and gives an SX function of one point
+    ``point_function(model) : (q, qd, p) -> (loads 9 x k, force 3, moment 3, point 3)``:
+    per load body (force N, point m, torque N·m, ground) for inverse dynamics, and the
+    surface's ground reaction force, its moment about ``point`` and that point (ground).
+    ``parameters()`` is the (1, n_p) row ``p`` (numbers or MX set by model modifiers, e.g.
+    the belt speed).
+    """
+
+    type: ClassVar[str] = ""
+    tools: ClassVar[frozenset[str]] = frozenset({"TO", "VO", "DO"})
+
+    name: str = ""
+    load_bodies: tuple[str, ...] = ()
+    force_labels: tuple[str, str, str] = ("", "", "")
+    moment_labels: tuple[str, str, str] = ("", "", "")
+    point_labels: tuple[str, str, str] = ("", "", "")
+
+    @classmethod
+    def discover(cls, setup: Any) -> list[ContactModel]:
+        """Instances of this contact model in the problem (possibly none)."""
+        return []
+
+    def point_function(self, model: Any) -> Any:
+        raise NotImplementedError(f"{type(self).__name__}.point_function")
+
+    def parameters(self) -> Any:
+        """(1, n_p) parameter row passed to the point function (may hold MX)."""
+        import numpy as _np
+
+        return _np.zeros((1, 0))
+
+
 class ModelModifier:
     """A Design Optimization model function: changes the model from static parameters.
 

@@ -34,6 +34,7 @@ KINDS: dict[str, str] = {
     "constraint": "nmsm_constraint_terms",
     "controller": "nmsm_controllers",
     "modifier": "nmsm_model_modifiers",
+    "contact": "nmsm_contact_models",
 }
 
 #: Tool codes used in ``tools`` class attributes.

@@ -91,21 +91,21 @@ class MuscleSpec:
 
 MUSCLES: dict[str, MuscleSpec] = {
     "iliacus_r": MuscleSpec("IL", (("pelvis", (-0.03, 0.03, 0.07)), ("pelvis", (-0.02, -0.08, 0.085)),
-                                   ("femur_r", (0.005, -0.06, 0.0))), 4500.0, 0.12, 0.10),
+                                   ("femur_r", (0.005, -0.06, 0.0))), 6300.0, 0.12, 0.10),
     "glmax_r": MuscleSpec("GMAX", (("pelvis", (-0.15, 0.0, 0.06)), ("pelvis", (-0.13, -0.10, 0.095)),
-                                   ("femur_r", (-0.03, -0.10, 0.03))), 3500.0, 0.10, 0.15),
+                                   ("femur_r", (-0.03, -0.10, 0.03))), 4900.0, 0.10, 0.15),
     "recfem_r": MuscleSpec("RF", (("pelvis", (-0.03, -0.04, 0.095)), ("femur_r", (0.045, -0.38, 0.0)),
-                                  ("tibia_r", (0.055, 0.0, 0.0)), ("tibia_r", (0.045, -0.07, 0.0))), 2500.0, 0.15, 0.08),
+                                  ("tibia_r", (0.055, 0.0, 0.0)), ("tibia_r", (0.045, -0.07, 0.0))), 3500.0, 0.15, 0.08),
     "hamstrings_r": MuscleSpec("HAM", (("pelvis", (-0.12, -0.10, 0.07)), ("tibia_r", (-0.035, -0.05, 0.0))),
-                               3200.0, 0.20, 0.10),
+                               4480.0, 0.20, 0.10),
     "vasti_r": MuscleSpec("VAS", (("femur_r", (0.03, -0.20, 0.02)), ("femur_r", (0.045, -0.38, 0.0)),
-                                  ("tibia_r", (0.055, 0.0, 0.0)), ("tibia_r", (0.045, -0.07, 0.0))), 5000.0, 0.07, 0.09),
+                                  ("tibia_r", (0.055, 0.0, 0.0)), ("tibia_r", (0.045, -0.07, 0.0))), 7000.0, 0.07, 0.09),
     "gastroc_r": MuscleSpec("GAS", (("femur_r", (-0.02, -0.40, 0.0)), ("tibia_r", (-0.045, -0.15, 0.0)),
-                                    ("calcn_r", (-0.05, 0.0, 0.0))), 3000.0, 0.25, 0.06),
+                                    ("calcn_r", (-0.05, 0.0, 0.0))), 4200.0, 0.25, 0.06),
     "soleus_r": MuscleSpec("SOL", (("tibia_r", (-0.02, -0.15, 0.0)), ("calcn_r", (-0.05, 0.0, 0.0))),
-                           5500.0, 0.35, 0.05),
+                           7700.0, 0.35, 0.05),
     "tibant_r": MuscleSpec("TA", (("tibia_r", (0.02, -0.15, 0.01)), ("tibia_r", (0.03, -0.40, 0.0)),
-                                  ("calcn_r", (0.09, -0.02, -0.01))), 2500.0, 0.10, 0.07),
+                                  ("calcn_r", (0.09, -0.02, -0.01))), 3500.0, 0.10, 0.07),
 }
 #: the synergy group (all muscles)
 SYNERGY_GROUP = "RightLeg"
@@ -168,8 +168,11 @@ def _joint(joints: etree._Element, name: str, parent: str, child: str, translati
     _frame(frames, f"{child}_offset", child, (0, 0, 0), orientations.get("child", (0, 0, 0)))
     transform = _sub(joint, "SpatialTransform")
     defaults = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+    # unused rotation axes must not be collinear with used ones (OpenSim refuses such joints)
+    used = [np.abs(np.asarray(axis, dtype=float)) for _, axis, *_ in rotations]
+    spare = iter(u for u in defaults if not any(np.allclose(np.asarray(u, dtype=float), a) for a in used))
     for k in range(3):
-        coordinate, axis = (rotations[k][0], rotations[k][1]) if k < len(rotations) else (None, defaults[k])
+        coordinate, axis = (rotations[k][0], rotations[k][1]) if k < len(rotations) else (None, next(spare))
         _axis(transform, f"rotation{k + 1}", coordinate, axis)
     named = {tuple(axis): coordinate for coordinate, axis, *_ in translations}
     for k, unit in enumerate(defaults):

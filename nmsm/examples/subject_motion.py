@@ -123,7 +123,7 @@ def foot_pose(t: np.ndarray, heel: Sequence[float], toes_joint: Sequence[float],
     start = off_pivot - _rotate(toes_bottom, np.full(s.shape, TOE_OFF_PITCH))
     end = (pivot[d] + [SPEED * CYCLE, 0.0]) - _rotate(heel_bottom, np.full(s.shape, HEEL_STRIKE_PITCH))
     origin[d] = start + blend[:, None] * (end - start)
-    origin[d, 1] += CLEARANCE * np.sin(np.pi * s) ** 2
+    origin[d, 1] += CLEARANCE * np.sin(np.pi * (1 - (1 - s) ** 2)) ** 2  # early lift, smooth start
     pitch[d] = TOE_OFF_PITCH + (HEEL_STRIKE_PITCH - TOE_OFF_PITCH) * blend
     toes[d] = -TOE_OFF_PITCH * (1 - _smooth(2 * s))
     return FootPose(origin[:, 0], origin[:, 1], pitch, toes)

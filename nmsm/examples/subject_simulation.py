@@ -1,23 +1,27 @@
 """The synthetic subject's forward simulation: its recorded gait is made here.
 
-The pelvis, hip adduction and hip rotation follow the reference (prescribed); hip flexion,
-knee, ankle and toes angles are *simulated*: their accelerations come from the model's
-mass matrix and inverse dynamics (nmsm's model core) under gravity, the muscles' forces
-(:mod:`nmsm.model.hill`, exact path geometry), the foot-ground springs of Ground Contact
-Personalization (:mod:`nmsm.model.foot_contact`) and a passive toes joint.
+The pelvis, hip adduction, hip rotation and the toes follow the reference (prescribed);
+hip flexion, knee and ankle angles are *simulated*: their accelerations come from the
+model's mass matrix and inverse dynamics (nmsm's model core) under gravity, the muscles'
+forces (:mod:`nmsm.model.hill`, exact path geometry) and the foot-ground springs of Ground
+Contact Personalization (:mod:`nmsm.model.foot_contact`).
 
-Muscles are excited through synergies, ``e = W^T c`` (W: S x M), with commands ``c >= 0``
-from a feed-forward design plus a joint-space feedback of the tracking error, mapped to
-commands by the damped inverse of the synergies' moment Jacobian at the current state;
-activation follows ``dn/dt = (c1 e + c2)(e - n)`` (time constants per muscle, deactivation
-4x slower) and the nonlinearity ``a = f_A(n)``. So the joint moments of hip, knee and ankle
-are exactly the muscles' moments, the ground reactions exactly the springs' forces.
+Muscles are driven by synergies at the activation level, ``a = c W`` (W: S x M, the truth
+NCP should recover), with commands ``c >= 0``. Each step a computed-torque controller asks
+for the accelerations ``udot_ref + K (q_ref - q) + D (u_ref - u)``; the commands in [0, 1]
+whose muscle moments best produce them (bounded least squares, scaled so no activation
+exceeds :data:`MAX_ACTIVATION`) are the targets the command state follows with rise and fall
+time constants :data:`RISE`, :data:`FALL` (so activations never change faster than the
+muscles' activation dynamics allow; the EMG is the excitation that produces them,
+:func:`nmsm.examples.subject_data.excitations_from_activations`). So the joint moments of
+hip, knee and ankle are exactly the muscles' moments, the ground reactions exactly the
+springs' forces.
 
 Design (:func:`design_synergies`): along the reference gait, per-frame non-negative least
-squares activations that reproduce the reference inverse-dynamics moments, a non-negative
-factorization of them into S synergies, and per-frame commands for those synergies.
+squares activations that reproduce the reference inverse-dynamics moments, and their
+non-negative factorization into S synergy vectors.
 
-Integration: classical Runge-Kutta, :data:`TIME_STEP` (s), as one CasADi ``mapaccum``.
+Integration: classical Runge-Kutta, :data:`TIME_STEP` (s), commands held over each step.
 Arrays: time on axis 0; SI units and radians.
 """
 
@@ -28,23 +32,25 @@ from collections.abc import Sequence
 import attrs
 import casadi as cs
 import numpy as np
-from scipy.interpolate import CubicSpline, make_interp_spline
+from scipy.interpolate import make_interp_spline
 from scipy.optimize import nnls
 
 from nmsm.examples.subject_model import MUSCLE_COORDINATES, STANDING_HEIGHT
-from nmsm.examples.subject_motion import LEG, PRESCRIBED, prescribed_values
-from nmsm.examples.subject_truth import TOES_DAMPING, TOES_STIFFNESS, MuscleTruth
+from nmsm.examples.subject_motion import PRESCRIBED, prescribed_values
+from nmsm.examples.subject_truth import MuscleTruth
 from nmsm.model import hill
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.foot_contact import ContactSurfaceModel
 from nmsm.model.muscle_geometry import MuscleGeometry
 
 TIME_STEP = 0.0005
-#: tracking feedback on hip flexion, knee, ankle, toes (1/s^2, 1/s); the toes get none (passive)
-GAIN_POSITION = np.array([400.0, 400.0, 400.0, 0.0])
-GAIN_VELOCITY = np.array([40.0, 40.0, 40.0, 0.0])
+#: tracking feedback on hip flexion, knee, ankle (1/s^2, 1/s)
+GAIN_POSITION = np.array([400.0, 400.0, 400.0])
+GAIN_VELOCITY = np.array([40.0, 40.0, 40.0])
 #: time constants (s) of the synergy commands rising and falling toward the controller's targets
-RISE, FALL = 0.012, 0.060
+RISE, FALL = 0.012, 0.040
+#: largest muscle activation the controller asks for (headroom for the excitation)
+MAX_ACTIVATION = 0.85
 
 
 @attrs.frozen
@@ -95,10 +101,9 @@ class SubjectDynamics:
         self.model = model
         self.cm = CasadiModel(model)
         self.names = model.coordinate_names
-        self.free = [self.names.index(c) for c in LEG]
+        self.free = [self.names.index(c) for c in MUSCLE_COORDINATES]
         self.prescribed = [i for i in range(len(self.names)) if i not in self.free]
         self.muscled = [self.names.index(c) for c in MUSCLE_COORDINATES]
-        self.toes = self.names.index("mtp_angle_r")
         self.muscles = muscles
         self.geometry = MuscleGeometry(model, list(model.muscle_names), list(MUSCLE_COORDINATES)).function()
         self.contact = contact
@@ -117,7 +122,7 @@ class SubjectDynamics:
         return cs.mtimes(arms.T, force), force, (length, velocity, arms, lt, vt)
 
     def accelerations(self, q, u, udot_prescribed, a):
-        """Accelerations of the free coordinates (4,) and the contact loads (9 x 2)."""
+        """Accelerations of the free coordinates (3,) and the contact loads (9 x 2)."""
         loads = self.loads(q, u)
         udot = cs.SX.zeros(len(self.names))
         for i in self.prescribed:
@@ -127,7 +132,6 @@ class SubjectDynamics:
         moments, _, _ = self.muscle_moments(q, u, a)
         for k, i in enumerate(self.muscled):
             applied[i] = moments[k]
-        applied[self.toes] = -TOES_STIFFNESS * q[self.toes] - TOES_DAMPING * u[self.toes]
         mass = self.mass(q)
         free = self.free
         rhs = cs.vertcat(*[applied[i] - bias[i] for i in free])
@@ -138,13 +142,11 @@ class SubjectDynamics:
 # ---------------------------------------------------------------------------------- design
 @attrs.frozen
 class Design:
-    """Feed-forward of the controller: synergy vectors ``weights`` (S, M), largest weight 1,
-    and commands ``commands`` (T, S) on ``time`` (s); ``activations`` (T, M) the per-frame
-    solution they were factored from, ``moments`` (T, 3) the reference moments."""
+    """The synergy vectors ``weights`` (S, M), largest weight 1, factored from the per-frame
+    ``activations`` (T, M) on ``time`` (s) that give the reference ``moments`` (T, 3)."""
 
     time: np.ndarray
     weights: np.ndarray
-    commands: np.ndarray
     activations: np.ndarray
     moments: np.ndarray
 
@@ -169,7 +171,7 @@ def _nmf(data: np.ndarray, rank: int, seed: int = 0, iterations: int = 3000) -> 
 
 def design_synergies(dynamics: SubjectDynamics, reference: Reference, time: np.ndarray, n_synergies: int,
                      regularization: float = 1e-3) -> Design:
-    """Synergies and feed-forward commands reproducing the reference moments (see module
+    """Synergy vectors of activations reproducing the reference moments (see module
     docstring); ``time`` (T,) the design frames (s), inside ``reference.time``."""
     index = np.searchsorted(reference.time, time)
     q, u, udot = reference.q[index], reference.u[index], reference.udot[index]
@@ -192,12 +194,7 @@ def design_synergies(dynamics: SubjectDynamics, reference: Reference, time: np.n
         lhs = np.vstack([gain, np.sqrt(regularization) * np.eye(len(m.f0))])
         activations[k] = nnls(lhs, np.concatenate([target[k] * scale, np.zeros(len(m.f0))]))[0]
     _, weights = _nmf(activations + 1e-3, n_synergies)
-    commands = np.zeros((n, n_synergies))
-    for k in range(n):
-        gain = (arms[k] * active[k][None, :] * scale[:, None]) @ weights.T
-        lhs = np.vstack([gain, np.sqrt(regularization) * np.eye(n_synergies)])
-        commands[k] = nnls(lhs, np.concatenate([target[k] * scale, np.zeros(n_synergies)]))[0]
-    return Design(time, weights, commands, activations, tau[:, dynamics.muscled])
+    return Design(time, weights, activations, tau[:, dynamics.muscled])
 
 
 # ---------------------------------------------------------------------------------- simulation
@@ -228,18 +225,18 @@ class _Functions:
         self.dynamics = dynamics
         n_syn = weights.shape[0]
         k = len(dynamics.prescribed)
-        x = cs.SX.sym("x", 8)  # q_free, u_free
+        x = cs.SX.sym("x", 6)  # q_free, u_free
         w = cs.SX.sym("w", 3 * k)  # prescribed q, u, udot
         c = cs.SX.sym("c", n_syn)
         q, u, udot_p = cs.SX.zeros(names), cs.SX.zeros(names), cs.SX.zeros(names)
         for j, i in enumerate(dynamics.free):
-            q[i], u[i] = x[j], x[4 + j]
+            q[i], u[i] = x[j], x[3 + j]
         for j, i in enumerate(dynamics.prescribed):
             q[i], u[i], udot_p[i] = w[j], w[k + j], w[2 * k + j]
         a = cs.mtimes(cs.DM(weights.T), c)
         udot_free, loads = dynamics.accelerations(q, u, udot_p, a)
         moments = dynamics.muscle_moments(q, u, a)[0]
-        self.rhs = cs.Function("rhs", [x, w, c], [cs.vertcat(x[4:8], udot_free)])
+        self.rhs = cs.Function("rhs", [x, w, c], [cs.vertcat(x[3:6], udot_free)])
         self.outputs = cs.Function("outputs", [x, w, c], [udot_free, cs.vec(loads), moments])
         # control: muscle moments = J c + passive; required moments of a desired acceleration
         m = dynamics.muscles
@@ -249,7 +246,7 @@ class _Functions:
         active = hill.active_tendon_force(1.0, lt, vt, cs.DM(m.f0), cs.DM(m.alpha))
         passive = hill.passive_tendon_force(lt, cs.DM(m.f0), cs.DM(m.alpha))
         jac = cs.mtimes(arms.T, cs.mtimes(cs.diag(active), cs.DM(weights.T)))
-        desired = cs.SX.sym("udot_desired", 4)
+        desired = cs.SX.sym("udot_desired", 3)
         udot = cs.SX(udot_p)
         for j, i in enumerate(dynamics.free):
             udot[i] = desired[j]
@@ -263,7 +260,8 @@ def simulate(dynamics: SubjectDynamics, reference: Reference, weights: np.ndarra
     """Integrate from the reference state at ``t0`` to ``t1`` (s) (see module docstring).
 
     Each step: desired accelerations ``udot_ref + K (q_ref - q) + D (u_ref - u)``; the
-    commands ``v`` in [0, 1] whose muscle moments best produce them (bounded least squares);
+    commands ``v`` in [0, 1] whose muscle moments best produce them (bounded least squares),
+    scaled down when a muscle's activation ``v W`` would exceed :data:`MAX_ACTIVATION`;
     the command state ``c`` follows ``v`` with :data:`RISE` / :data:`FALL` time constants
     (so activations never rise or fall faster than the muscles' dynamics allow); RK4 over
     the step with ``c`` held.
@@ -285,12 +283,13 @@ def simulate(dynamics: SubjectDynamics, reference: Reference, weights: np.ndarra
     h = time_step
     for k in range(steps + 1):
         q_ref, u_ref, udot_ref = (r[:, k] for r in ref_full)
-        error_q, error_u = q_ref - x[:4], u_ref - x[4:]
+        error_q, error_u = q_ref - x[:3], u_ref - x[3:]
         desired = udot_ref + GAIN_POSITION * error_q + GAIN_VELOCITY * error_u
         jac, needed = (np.array(v) for v in f.control(x, w_full[:, k], desired))
         scale = 1.0 / np.array([100.0, 100.0, 100.0])
         target = lsq_linear(np.vstack([jac * scale[:, None], regularization]),
                             np.concatenate([needed.ravel() * scale, np.zeros(n_syn)]), bounds=(0.0, 1.0)).x
+        target /= max(1.0, float(np.max(weights.T @ target)) / MAX_ACTIVATION)
         rate = np.where(target > c, 1.0 / RISE, 1.0 / FALL)
         c = c + (target - c) * (1.0 - np.exp(-rate * h)) if k > 0 else target.copy()
         commands.append(c.copy())
@@ -310,7 +309,7 @@ def simulate(dynamics: SubjectDynamics, reference: Reference, weights: np.ndarra
     q_all, u_all, udot_all = np.zeros((n, names)), np.zeros((n, names)), np.zeros((n, names))
     q_all[:, prescribed], u_all[:, prescribed], udot_all[:, prescribed] = (w_full[:kp].T, w_full[kp:2 * kp].T,
                                                                          w_full[2 * kp:].T)
-    q_all[:, free], u_all[:, free], udot_all[:, free] = states_arr[:, :4], states_arr[:, 4:], udot_free.T
+    q_all[:, free], u_all[:, free], udot_all[:, free] = states_arr[:, :3], states_arr[:, 3:], udot_free.T
     loads = loads.T.reshape(n, 9, 2, order="F")
     force = loads[:, 0:3, :].sum(axis=2)
     moment = np.zeros_like(force)
@@ -323,13 +322,13 @@ def simulate(dynamics: SubjectDynamics, reference: Reference, weights: np.ndarra
 def _inputs(reference: Reference, dynamics: SubjectDynamics, t: np.ndarray
             ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Prescribed ``(q, u, udot)`` stacked (3k, len(t)) and the free coordinates' reference
-    ``(q, u, udot)`` (4, len(t)) each, at times ``t``."""
+    ``(q, u, udot)`` (3, len(t)) each, at times ``t``."""
     q = np.empty((t.size, len(dynamics.names)))
     u, udot = np.empty_like(q), np.empty_like(q)
     for i, name in enumerate(dynamics.names):
         if name in PRESCRIBED:
             q[:, i], u[:, i], udot[:, i] = prescribed_values(name, t, STANDING_HEIGHT)
-        else:
+        else:  # simulated coordinates and the toes: the reference
             q[:, i] = np.interp(t, reference.time, reference.q[:, i])
             u[:, i] = np.interp(t, reference.time, reference.u[:, i])
             udot[:, i] = np.interp(t, reference.time, reference.udot[:, i])

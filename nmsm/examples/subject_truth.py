@@ -6,8 +6,8 @@
 * Muscles (MTP): activation time constant (s), activation nonlinearity, electromechanical
   delay (s), optimal fiber length and tendon slack length of every muscle; the generic model
   has lengths divided by :data:`LENGTH_SCALES` (so MTP's scale factors should come out as
-  those numbers). The EMG scale factor is ``max`` of the muscle's excitation over the
-  recording, because preprocessing normalizes each EMG channel by its maximum.
+  those numbers). The EMG scale factor maps the *processed* EMG (normalized by its maximum)
+  to the excitation: :func:`nmsm.examples.subject.effective_emg_scales`.
 * Synergies (NCP): the excitation synergy vectors ``W`` (S x M, largest weight 1).
 * Foot contact (GCP): spring constants (N/m) over the GCP spring grid, damping (s/m),
   friction coefficients and resting spring length (m).
@@ -34,7 +34,7 @@ JOINT_PATTERN: dict[tuple[str, str], tuple[float, float]] = {
 }
 #: true muscle properties per muscle (MUSCLES order): activation time constant (s),
 #: nonlinearity, electromechanical delay (s)
-ACTIVATION_TIME_CONSTANTS = (0.012, 0.018, 0.015, 0.020, 0.014, 0.016, 0.022, 0.013)
+ACTIVATION_TIME_CONSTANTS = (0.0080, 0.0100, 0.0090, 0.0095, 0.0085, 0.0100, 0.0090, 0.0080)
 NONLINEARITY = (0.10, 0.20, 0.15, 0.08, 0.25, 0.12, 0.18, 0.22)
 DELAYS = (0.05, 0.07, 0.04, 0.06, 0.08, 0.05, 0.07, 0.06)
 #: true / generic optimal fiber length and tendon slack length
@@ -48,8 +48,6 @@ CONTACT = {"damping_factor": 0.25, "dynamic_friction_coefficient": 0.7, "viscous
            "resting_spring_length": 0.012, "latching_velocity": 0.05}
 #: mean spring constant (N/m) and its heel-to-toe rise (fraction)
 SPRING_CONSTANT, SPRING_GRADIENT = 1200.0, 0.5
-#: passive toes joint: stiffness (N m/rad), damping (N m s/rad)
-TOES_STIFFNESS, TOES_DAMPING = 8.0, 0.15
 
 
 @attrs.frozen

@@ -2,17 +2,19 @@
 
 :func:`write_synthetic_gcp` writes into a folder:
 
-* ``foot.osim``: a two-segment foot (``calcn`` moved by a 6-coordinate CustomJoint to
-  ground whose rotation axes are Y, X, Z, so its coordinates are exactly GCP's foot
-  coordinates; ``toes`` on a PinJoint ``mtp``) with the five GCP foot markers;
-* ``ik.sto``: a treadmill stance (0.6 s, 100 Hz): the foot pitches from heel strike
-  (toes up) through flat foot to heel rise with the toes staying flat, moving backwards
-  with the belt, with small out-of-plane rotations; its height puts the lowest spring
-  ``depth(t)`` below the resting spring length (up to 6 mm);
-* ``grf.sto``: the ground reactions the contact model gives with the true springs and
-  properties (:class:`SyntheticTruth`) for that motion, as a force plate reports them
-  (moments about a fixed electrical center), so the experimental reactions GCP compares
-  with are exactly the model's at the truth;
+* ``foot.osim``: one or two two-segment feet (``calcn_<s>`` moved by a 6-coordinate
+  CustomJoint to ground whose rotation axes are Y, X, Z for the right foot and -Y, -X, Z
+  for the left, so its coordinates are exactly GCP's foot coordinates; ``toes_<s>`` on a
+  PinJoint ``mtp_<s>``) with the five GCP foot markers (``R_``/``L_`` prefixes);
+* ``ik.sto``: a treadmill stance per foot (0.6 s at 100 Hz; the left foot's window
+  starts 0.5 s later): the foot pitches from heel strike (toes up) through flat foot to
+  heel rise with the toes staying flat, moving backwards with the belt, with small
+  out-of-plane rotations; its height puts the lowest spring ``depth(t)`` below the
+  resting spring length (up to 7 mm). The left foot is the mirror image of the right;
+* ``grf.sto``: per foot (plates ``1`` right, ``2`` left) the ground reactions the contact
+  model gives with the true springs and properties (:class:`SyntheticTruth`) for that
+  motion, as a force plate reports them (moments about a fixed electrical center), so the
+  experimental reactions GCP compares with are exactly the model's at the truth;
 * ``settings.xml``: GCP settings (two tasks) starting from other values than the truth.
 
 Running GCP on it must recover the ground reactions to numerical precision and the
@@ -30,10 +32,11 @@ from lxml import etree
 
 from nmsm.io.storage import table_from_columns, write_storage
 
-#: coordinates of the foot's joint to ground, in order (rotations about Y, X, Z; translations)
+#: coordinates of a foot's joint to ground, in order (rotations about Y, X, Z; translations)
 FOOT_JOINT_COORDINATES = ("foot_rotation_y", "foot_rotation_x", "foot_rotation_z", "foot_tx", "foot_ty", "foot_tz")
 TOE_COORDINATE = "mtp_angle"
-MARKERS = {  # name -> (body, location m)
+#: marker -> (body, location m) of the right foot; the left foot mirrors z
+MARKERS = {
     "Heel": ("calcn", (-0.03, 0.015, 0.0)),
     "Toe_Medial": ("calcn", (0.16, 0.0, -0.045)),
     "Toe_Lateral": ("calcn", (0.14, 0.0, 0.045)),
@@ -44,8 +47,21 @@ MARKERS = {  # name -> (body, location m)
 MTP_LOCATION = (0.17, -0.015, 0.0)
 #: calcn origin height (m) in the default pose: springs sit this far below it
 DEFAULT_HEIGHT = 0.04
-ELECTRICAL_CENTER = (0.4, 0.0, 0.25)
-GRF_COLUMNS = {"force": ("f_vx", "f_vy", "f_vz"), "moment": ("m_x", "m_y", "m_z"), "center": ("f_px", "f_py", "f_pz")}
+#: side -> (marker prefix, plate, electrical center m, start of the stance s, z offset m)
+SIDES = {
+    "r": ("R_", "1", (0.4, 0.0, 0.25), 0.0, 0.25),
+    "l": ("L_", "2", (0.4, 0.0, -0.25), 0.5, -0.25),
+}
+STANCE = 0.6  #: s
+RATE = 100.0  #: Hz
+
+
+def grf_columns(side: str) -> dict[str, tuple[str, str, str]]:
+    """Force, moment and electrical-center column names of a side's plate."""
+    plate = SIDES[side][1]
+    return {"force": (f"f{plate}_vx", f"f{plate}_vy", f"f{plate}_vz"),
+            "moment": (f"m{plate}_x", f"m{plate}_y", f"m{plate}_z"),
+            "center": (f"f{plate}_px", f"f{plate}_py", f"f{plate}_pz")}
 
 
 @attrs.frozen
@@ -119,40 +135,42 @@ def _frames(joint: etree._Element, parent: str, child: str, translation: Sequenc
         _sub(frame, "orientation", "0 0 0")
 
 
-def foot_model_xml() -> str:
-    """The ``.osim`` text of the synthetic foot (module docstring)."""
+def foot_model_xml(sides: Sequence[str] = ("r",)) -> str:
+    """The ``.osim`` text of the synthetic feet (module docstring)."""
     root = etree.Element("OpenSimDocument", Version="40000")
-    model = _sub(root, "Model", name="synthetic_foot")
+    model = _sub(root, "Model", name="synthetic_feet")
     _sub(model, "gravity", "0 -9.80665 0")
     _sub(model, "Ground", name="ground")
     bodies = _sub(_sub(model, "BodySet", name="bodyset"), "objects")
-    _body(bodies, "calcn", 1.0)
-    _body(bodies, "toes", 0.2)
     joints = _sub(_sub(model, "JointSet", name="jointset"), "objects")
-    joint = _sub(joints, "CustomJoint", name="ground_calcn")
-    coordinates = _sub(joint, "coordinates")
-    for name in FOOT_JOINT_COORDINATES:
-        default = DEFAULT_HEIGHT if name == "foot_ty" else 0.0
-        _coordinate(coordinates, name, default, (-3.0, 3.0))
-    _frames(joint, "ground", "calcn", (0, 0, 0))
-    transform = _sub(joint, "SpatialTransform")
-    axes = ((0, 1, 0), (1, 0, 0), (0, 0, 1), (1, 0, 0), (0, 1, 0), (0, 0, 1))
-    for k, (name, axis) in enumerate(zip(FOOT_JOINT_COORDINATES, axes)):
-        kind = "rotation" if k < 3 else "translation"
-        ta = _sub(transform, "TransformAxis", name=f"{kind}{k % 3 + 1}")
-        _sub(ta, "coordinates", name)
-        _sub(ta, "axis", _vec(axis))
-        function = _sub(ta, "LinearFunction", name="function")
-        _sub(function, "coefficients", "1 0")
-    pin = _sub(joints, "PinJoint", name="mtp")
-    _coordinate(_sub(pin, "coordinates"), TOE_COORDINATE, 0.0, (-1.5, 1.5))
-    _frames(pin, "calcn", "toes", MTP_LOCATION)
     markers = _sub(_sub(model, "MarkerSet", name="markerset"), "objects")
-    for name, (body, location) in MARKERS.items():
-        marker = _sub(markers, "Marker", name=name)
-        _sub(marker, "socket_parent_frame", f"/bodyset/{body}")
-        _sub(marker, "location", _vec(location))
-        _sub(marker, "fixed", "false")
+    for side in sides:
+        mirror = -1.0 if side == "l" else 1.0
+        _body(bodies, f"calcn_{side}", 1.0)
+        _body(bodies, f"toes_{side}", 0.2)
+        joint = _sub(joints, "CustomJoint", name=f"ground_calcn_{side}")
+        coordinates = _sub(joint, "coordinates")
+        for name in FOOT_JOINT_COORDINATES:
+            default = DEFAULT_HEIGHT if name == "foot_ty" else 0.0
+            _coordinate(coordinates, f"{name}_{side}", default, (-3.0, 3.0))
+        _frames(joint, "ground", f"calcn_{side}", (0, 0, 0))
+        transform = _sub(joint, "SpatialTransform")
+        axes = ((0, mirror, 0), (mirror, 0, 0), (0, 0, 1), (1, 0, 0), (0, 1, 0), (0, 0, 1))
+        for k, (name, axis) in enumerate(zip(FOOT_JOINT_COORDINATES, axes)):
+            kind = "rotation" if k < 3 else "translation"
+            ta = _sub(transform, "TransformAxis", name=f"{kind}{k % 3 + 1}")
+            _sub(ta, "coordinates", f"{name}_{side}")
+            _sub(ta, "axis", _vec(axis))
+            function = _sub(ta, "LinearFunction", name="function")
+            _sub(function, "coefficients", "1 0")
+        pin = _sub(joints, "PinJoint", name=f"mtp_{side}")
+        _coordinate(_sub(pin, "coordinates"), f"{TOE_COORDINATE}_{side}", 0.0, (-1.5, 1.5))
+        _frames(pin, f"calcn_{side}", f"toes_{side}", MTP_LOCATION)
+        for name, (body, location) in MARKERS.items():
+            marker = _sub(markers, "Marker", name=f"{SIDES[side][0]}{name}")
+            _sub(marker, "socket_parent_frame", f"/bodyset/{body}_{side}")
+            _sub(marker, "location", _vec((location[0], location[1], mirror * location[2])))
+            _sub(marker, "fixed", "false")
     return etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="UTF-8").decode()
 
 
@@ -162,9 +180,10 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
     return x * x * x * (10 - 15 * x + 6 * x * x)
 
 
-def stance_angles(time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(pitch about z, rotation about y, rotation about x, toe angle)`` (rad) over ``time``."""
-    s = (time - time[0]) / (time[-1] - time[0])
+def stance_angles(time: np.ndarray, start: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(pitch about z, rotation about y, rotation about x, toe angle)`` (rad) of a stance
+    starting at ``start`` s, over ``time`` (inside the stance)."""
+    s = (time - start) / STANCE
     pitch = 0.25 * (1 - _smoothstep(s / 0.3)) - 0.45 * _smoothstep((s - 0.6) / 0.4)
     toe = -np.minimum(pitch, 0.0)
     about_y = 0.05 * np.sin(2 * np.pi * s)
@@ -173,14 +192,28 @@ def stance_angles(time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 
 
 def penetration(time: np.ndarray) -> np.ndarray:
-    """Depth (m) of the lowest spring below the resting length: 0 at both ends, 6 mm mid."""
+    """Depth (m) of the lowest spring below the resting length over a stance's frames
+    ``time``: 1 mm at both ends, 7 mm mid-stance."""
     s = (time - time[0]) / (time[-1] - time[0])
     return 0.006 * np.sin(np.pi * s) ** 1.5 + 0.001
 
 
 # ------------------------------------------------------------------------------ the case
-def write_synthetic_gcp(folder: str | Path, truth: SyntheticTruth = SyntheticTruth(), *, frames: int = 61,
-                        grid: tuple[int, int] = (5, 7)) -> SyntheticGcp:
+def _foot_motion(time: np.ndarray, start: float, side: str, belt_speed: float) -> dict[str, np.ndarray]:
+    """Coordinates of one foot over the whole ``time`` (its stance from ``start``; clamped
+    outside). Mirrored joint axes make the left foot the mirror image with equal values."""
+    local = np.clip(time, start, start + STANCE)
+    pitch, about_y, about_x, toe = stance_angles(local, start)
+    z0 = SIDES[side][4]
+    s = (local - start) / STANCE
+    values = {"foot_rotation_y": about_y, "foot_rotation_x": about_x, "foot_rotation_z": pitch,
+              "foot_tx": 0.35 - belt_speed * (local - start), "foot_ty": np.full_like(time, DEFAULT_HEIGHT),
+              "foot_tz": z0 + np.sign(z0) * 0.01 * np.sin(np.pi * s), TOE_COORDINATE: toe}
+    return {f"{k}_{side}": v for k, v in values.items()}
+
+
+def write_synthetic_gcp(folder: str | Path, truth: SyntheticTruth = SyntheticTruth(), *,
+                        sides: Sequence[str] = ("r",), grid: tuple[int, int] = (5, 7)) -> SyntheticGcp:
     """Write the synthetic case into ``folder`` (created) and return its paths and truth."""
     from nmsm.io.settings.document import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
@@ -190,28 +223,30 @@ def write_synthetic_gcp(folder: str | Path, truth: SyntheticTruth = SyntheticTru
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    sides = tuple(sides)
     model_file = folder / "foot.osim"
-    model_file.write_text(foot_model_xml(), encoding="utf-8")
-    time = np.linspace(0.0, 0.6, frames)
+    model_file.write_text(foot_model_xml(sides), encoding="utf-8")
+    end = max(SIDES[side][3] for side in sides) + STANCE
+    time = np.round(np.arange(0.0, end + 0.5 / RATE, 1.0 / RATE), 10)
     motion_file, grf_file, settings_file = folder / "ik.sto", folder / "grf.sto", folder / "settings.xml"
-    settings_file.write_text(settings_xml(grid, truth), encoding="utf-8")
-    pitch, about_y, about_x, toe = stance_angles(time)
-    tx = 0.35 - truth.belt_speed * time
-    tz = 0.25 + 0.01 * np.sin(np.pi * (time - time[0]) / (time[-1] - time[0]))
-    values = {"foot_rotation_y": about_y, "foot_rotation_x": about_x, "foot_rotation_z": pitch, "foot_tx": tx,
-              "foot_ty": np.full_like(time, DEFAULT_HEIGHT), "foot_tz": tz, TOE_COORDINATE: toe}
+    settings_file.write_text(settings_xml(grid, truth, sides), encoding="utf-8")
+    values: dict[str, np.ndarray] = {}
+    for side in sides:
+        values.update(_foot_motion(time, SIDES[side][3], side, truth.belt_speed))
     write_storage(motion_file, table_from_columns(time, values, name="ik"))
-    _write_grf(grf_file, time, np.zeros((frames, 3)), np.zeros((frames, 3)))
+    plates = {side: (np.zeros((time.size, 3)), np.zeros((time.size, 3))) for side in sides}
+    _write_grf(grf_file, time, plates)
     settings = GroundContactPersonalizationSettings.from_document(read_settings_document(settings_file))
     feet, *_ = load_feet(settings)
-    foot = feet[0]
-    lowest = _lowest_spring_height(foot)
-    values["foot_ty"] = DEFAULT_HEIGHT - lowest + truth.resting_spring_length - penetration(time)
+    for side, foot in zip(sides, feet):
+        rows = np.flatnonzero(np.isin(np.round(time, 9), np.round(foot.time, 9)))
+        ty = values[f"foot_ty_{side}"]
+        ty[rows] = DEFAULT_HEIGHT - _lowest_spring_height(foot) + truth.resting_spring_length - penetration(foot.time)
+        ty[: rows[0]] = ty[rows[0]]
+        ty[rows[-1] + 1:] = ty[rows[-1]]
     write_storage(motion_file, table_from_columns(time, values, name="ik"))
     feet, *_ = load_feet(settings)
-    foot = feet[0]
-    along = _normalized_along(foot)
-    k_true = truth.spring_constants(along)
+    k_true = truth.spring_constants(_normalized_along(feet[0]))
     state = GcpState.initial(settings, feet)
     state.spring_constants = k_true
     state.damping_factor = truth.damping_factor
@@ -219,31 +254,35 @@ def write_synthetic_gcp(folder: str | Path, truth: SyntheticTruth = SyntheticTru
     state.viscous_friction_coefficient = truth.viscous_friction_coefficient
     state.resting_spring_length = truth.resting_spring_length
     state.latching_velocity = truth.latching_velocity
-    modeled = foot_values(foot, state.design(), 0)
-    forces = as_array(modeled.forces).T
-    moments = as_array(modeled.moments).T
-    center = np.tile(np.asarray(ELECTRICAL_CENTER, dtype=float), (frames, 1))
-    point = foot.midfoot.copy()
-    point[:, 1] = 0.0
-    lever = np.array([0.0, -truth.resting_spring_length, 0.0])
-    plate_moments = moments - np.cross(center - point, forces) - np.cross(np.broadcast_to(lever, forces.shape), forces)
-    _write_grf(grf_file, time, forces, plate_moments)
+    design = state.design()
+    for i, (side, foot) in enumerate(zip(sides, feet)):
+        modeled = foot_values(foot, design, i)
+        forces = as_array(modeled.forces).T
+        moments = as_array(modeled.moments).T
+        center = np.tile(np.asarray(SIDES[side][2], dtype=float), (foot.n_frames, 1))
+        point = foot.midfoot.copy()
+        point[:, 1] = 0.0
+        lever = np.broadcast_to(np.array([0.0, -truth.resting_spring_length, 0.0]), forces.shape)
+        rows = np.flatnonzero(np.isin(np.round(time, 9), np.round(foot.time, 9)))
+        plates[side][0][rows] = forces
+        plates[side][1][rows] = moments - np.cross(center - point, forces) - np.cross(lever, forces)
+    _write_grf(grf_file, time, plates)
     return SyntheticGcp(folder, model_file, motion_file, grf_file, settings_file, truth, k_true)
 
 
-def _write_grf(path: Path, time: np.ndarray, forces: np.ndarray, moments: np.ndarray) -> None:
+def _write_grf(path: Path, time: np.ndarray, plates: dict[str, tuple[np.ndarray, np.ndarray]]) -> None:
     columns: dict[str, np.ndarray] = {}
-    for k, label in enumerate(GRF_COLUMNS["force"]):
-        columns[label] = forces[:, k]
-    for k, label in enumerate(GRF_COLUMNS["center"]):
-        columns[label] = np.full(time.size, ELECTRICAL_CENTER[k])
-    for k, label in enumerate(GRF_COLUMNS["moment"]):
-        columns[label] = moments[:, k]
+    for side, (forces, moments) in plates.items():
+        names = grf_columns(side)
+        for k in range(3):
+            columns[names["force"][k]] = forces[:, k]
+            columns[names["center"][k]] = np.full(time.size, SIDES[side][2][k])
+            columns[names["moment"][k]] = moments[:, k]
     write_storage(path, table_from_columns(time, columns, name="grf"))
 
 
 def _lowest_spring_height(foot: object) -> np.ndarray:
-    """Lowest spring height (m) per frame at the experimental kinematics."""
+    """Lowest spring height (m) per frame of the foot's window at the experimental kinematics."""
     import casadi as cs
 
     positions = foot.foot.point_positions(foot.springs.points())
@@ -258,9 +297,9 @@ def _normalized_along(foot: object) -> np.ndarray:
     return (x - x.min()) / (x.max() - x.min())
 
 
-def settings_xml(grid: tuple[int, int], truth: SyntheticTruth = SyntheticTruth()) -> str:
+def settings_xml(grid: tuple[int, int], truth: SyntheticTruth = SyntheticTruth(), sides: Sequence[str] = ("r",)) -> str:
     """GCP settings for the case: two tasks (all properties with kinematics, then again with
-    moments weighted more), initial values away from the truth."""
+    forces and moments weighted more), initial values away from the truth."""
     terms = """
         <RCNLCostTermSet>
           <RCNLCostTerm><is_enabled>true</is_enabled><type>marker_position</type><max_allowable_error>0.002</max_allowable_error></RCNLCostTerm>
@@ -276,6 +315,22 @@ def settings_xml(grid: tuple[int, int], truth: SyntheticTruth = SyntheticTruth()
         f"<GCPTask><is_enabled>true</is_enabled><index>{i}</index>{flags.format(rest=rest)}"
         f"{terms.format(v=v, h=h, m=m)}</GCPTask>"
         for i, rest, v, h, m in ((1, "true", 5, 5, 2), (2, "false", 1, 1, 0.2)))
+    surfaces = ""
+    for side in sides:
+        prefix, _, _, start, _ = SIDES[side]
+        names = grf_columns(side)
+        surfaces += f"""
+      <GCPContactSurface name="{side}">
+        <is_enabled>true</is_enabled><is_left_foot>{"true" if side == "l" else "false"}</is_left_foot>
+        <start_time>{start}</start_time><end_time>{start + STANCE}</end_time><belt_speed>{truth.belt_speed}</belt_speed>
+        <force_columns>{" ".join(names["force"])}</force_columns>
+        <moment_columns>{" ".join(names["moment"])}</moment_columns>
+        <electrical_center_columns>{" ".join(names["center"])}</electrical_center_columns>
+        <hindfoot_body>calcn_{side}</hindfoot_body>
+        <toe_marker>{prefix}Toe</toe_marker><medial_marker>{prefix}Toe_Medial</medial_marker>
+        <lateral_marker>{prefix}Toe_Lateral</lateral_marker><heel_marker>{prefix}Heel</heel_marker>
+        <midfoot_superior_marker>{prefix}Midfoot_Superior</midfoot_superior_marker>
+      </GCPContactSurface>"""
     return f"""<NMSMPipelineDocument Version="1.5.0">
   <GroundContactPersonalizationTool>
     <results_directory>results</results_directory>
@@ -286,17 +341,7 @@ def settings_xml(grid: tuple[int, int], truth: SyntheticTruth = SyntheticTruth()
     <initialize_resting_spring_length>true</initialize_resting_spring_length>
     <grid_width>{grid[0]}</grid_width>
     <grid_height>{grid[1]}</grid_height>
-    <GCPContactSurfaceSet>
-      <GCPContactSurface name="foot">
-        <is_enabled>true</is_enabled><is_left_foot>false</is_left_foot>
-        <start_time>0</start_time><end_time>0.6</end_time><belt_speed>{truth.belt_speed}</belt_speed>
-        <force_columns>{" ".join(GRF_COLUMNS["force"])}</force_columns>
-        <moment_columns>{" ".join(GRF_COLUMNS["moment"])}</moment_columns>
-        <electrical_center_columns>{" ".join(GRF_COLUMNS["center"])}</electrical_center_columns>
-        <hindfoot_body>calcn</hindfoot_body>
-        <toe_marker>Toe</toe_marker><medial_marker>Toe_Medial</medial_marker><lateral_marker>Toe_Lateral</lateral_marker>
-        <heel_marker>Heel</heel_marker><midfoot_superior_marker>Midfoot_Superior</midfoot_superior_marker>
-      </GCPContactSurface>
+    <GCPContactSurfaceSet>{surfaces}
     </GCPContactSurfaceSet>
     <GCPTaskList>{tasks}</GCPTaskList>
     <initial_resting_spring_length>0.02</initial_resting_spring_length>

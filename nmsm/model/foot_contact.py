@@ -12,7 +12,8 @@ spring ``j`` with stiffness ``K_j`` (N/m) pushes on its body with (tools.md §6.
       F_y  = F_el (1 - D ydot)
 
   ``k_low = 0.1`` N/m, ``h_off = 1e-3`` m, ``c = 1e-3`` m, ``y_max = 1e-2`` m: ``F_el`` is
-  ``-K y`` in contact, has slope ``k_low`` out of contact and is zero at ``y = y_max``.
+  ``-K (y + h_off)`` in contact (``y`` a few ``c`` below ``-h_off``), has slope ``k_low``
+  out of contact and is zero at ``y = y_max``.
   ``D`` (s/m) is the damping factor common to all springs.
 * friction (N): with slip velocity ``u = (xdot + belt_speed, zdot)`` (m/s),
   ``v_s = |u|`` (0 below 1e-10), ``|F_h| = F_y (mu_d tanh(v_s/v_latch) + mu_v v_s)`` and

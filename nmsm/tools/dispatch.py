@@ -17,12 +17,22 @@ TOOL_RUNNERS: dict[str, str] = {
     "TrackingOptimizationTool": "nmsm.tools.treatment.run:run_settings",
     "VerificationOptimizationTool": "nmsm.tools.treatment.run:run_settings",
     "DesignOptimizationTool": "nmsm.tools.treatment.run:run_settings",
+    # the pipeline's own stages and pipeline files (nmsm.tools.pipeline.native.NATIVE_RUNNERS)
+    "PipelineTool": "nmsm.tools.pipeline.runner:run_pipeline_file",
+    "ModelAnalysisTool": "nmsm.tools.pipeline.analysis:run_settings",
+    "DataPreprocessingTool": "nmsm.tools.pipeline.preprocess_stage:run_settings",
+    "SurrogateDataTool": "nmsm.tools.pipeline.surrogate_stage:run_settings",
 }
 
 
 def tool_element_name(settings_file: str | Path) -> str:
     """The tool element of a settings file (old schemas upgraded first)."""
     from nmsm.io.settings.document import read_settings_document
+    from nmsm.tools.pipeline.native import native_tool_element
+
+    native = native_tool_element(settings_file)  # the pipeline's own stages and pipeline files
+    if native is not None:
+        return native
 
     doc = read_settings_document(settings_file)
     return doc.tool_element.tag

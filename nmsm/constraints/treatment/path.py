@@ -3,7 +3,8 @@
 ``<family>_deviation`` = modeled - tracked, ``<family>_value`` = modeled, at every collocation
 point, bounded by ``[min_error, max_error]``. Families: ``generalized_coordinate``,
 ``generalized_speed``, ``generalized_acceleration`` (rad|m, /s, /s²), ``marker_position``,
-``marker_velocity`` (m, m/s; one ``axis``), ``body_orientation`` (rad; ``axis``, ``sequence``).
+``marker_velocity`` (m, m/s; one ``axis``), ``body_orientation`` (rad; ``axis``, ``sequence``),
+``external_force`` / ``external_moment`` (ground reaction columns of the contact models, N, N·m).
 Also ``controller_deviation`` (u - scale·u_init) / ``controller_value`` (u),
 ``muscle_activation_deviation`` (a - scale·a_exp) / ``muscle_activation_value`` (a), and
 ``limit_normalized_fiber_length`` (l̃ of a muscle, DO).
@@ -151,6 +152,50 @@ class BodyOrientationValue(_BodyPath):
 
     type: ClassVar[str] = "body_orientation_value"
     family: ClassVar[str] = "body_orientation"
+
+
+@attrs.frozen(kw_only=True)
+class _ForcePath(_SignalPath):
+    force: str
+
+
+@attrs.frozen(kw_only=True)
+class _MomentPath(_SignalPath):
+    moment: str
+
+
+@attrs.frozen(kw_only=True)
+class ExternalForceDeviation(_ForcePath):
+    """F - F_exp of a ground reaction force column (N)."""
+
+    type: ClassVar[str] = "external_force_deviation"
+    family: ClassVar[str] = "external_force"
+    deviation: ClassVar[bool] = True
+
+
+@attrs.frozen(kw_only=True)
+class ExternalForceValue(_ForcePath):
+    """F of a ground reaction force column (N)."""
+
+    type: ClassVar[str] = "external_force_value"
+    family: ClassVar[str] = "external_force"
+
+
+@attrs.frozen(kw_only=True)
+class ExternalMomentDeviation(_MomentPath):
+    """M - M_exp of a ground reaction moment column (N·m)."""
+
+    type: ClassVar[str] = "external_moment_deviation"
+    family: ClassVar[str] = "external_moment"
+    deviation: ClassVar[bool] = True
+
+
+@attrs.frozen(kw_only=True)
+class ExternalMomentValue(_MomentPath):
+    """M of a ground reaction moment column (N·m)."""
+
+    type: ClassVar[str] = "external_moment_value"
+    family: ClassVar[str] = "external_moment"
 
 
 @attrs.frozen(kw_only=True)

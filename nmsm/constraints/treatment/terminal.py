@@ -1,7 +1,7 @@
 """Terminal constraints (catalog §1.4): values at the movement's start (t0) and end (t_f).
 
 For each family - ``generalized_coordinate``, ``generalized_speed``, ``marker_position``,
-``marker_velocity``, ``body_orientation`` - five types:
+``marker_velocity``, ``body_orientation``, ``external_force``, ``external_moment`` - five types:
 
 ``<family>_periodicity``        value(t_f) - value(t0)
 ``initial_<family>_deviation``  modeled(t0) - tracked(t0)
@@ -92,6 +92,16 @@ class _BodyTerminal(_Terminal):
 
 
 @attrs.frozen(kw_only=True)
+class _ForceTerminal(_Terminal):
+    force: str
+
+
+@attrs.frozen(kw_only=True)
+class _MomentTerminal(_Terminal):
+    moment: str
+
+
+@attrs.frozen(kw_only=True)
 class RootSegmentResidualLoadPeriodicity(_Terminal):
     """τ_ID(t_f) - τ_ID(t0) of a load (N·m or N)."""
 
@@ -107,6 +117,8 @@ _BASES = {
     "marker_position": _MarkerTerminal,
     "marker_velocity": _MarkerTerminal,
     "body_orientation": _BodyTerminal,
+    "external_force": _ForceTerminal,
+    "external_moment": _MomentTerminal,
 }
 
 

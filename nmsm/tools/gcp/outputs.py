@@ -25,8 +25,9 @@ When every foot has the same window:
   markers (:mod:`nmsm.tools.gcp.ik_update`), degrees for rotational coordinates.
 
 ``<osimx or model stem>_gcp.osimx`` holds the contact surfaces (appended to the input
-``.osimx``'s, replacing a surface on the same hindfoot), and ``<model>_gcpErrors.txt`` the
-error table (:mod:`nmsm.tools.gcp.report`).
+``.osimx``'s, replacing a surface on the same hindfoot), ``<model>_gcpErrors.txt`` the
+error table (:mod:`nmsm.tools.gcp.report`), ``commandWindowOutput.txt`` the run's solver
+summaries, and the settings file is copied in.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from nmsm.io.osimx import GcpSpring, OsimxContactSurface, OsimxModel, write_osimx
+from nmsm.io.osimx import GcpSpring, OsimxContactSurface, OsimxModel
 from nmsm.io.storage import Table, table_from_columns, write_storage
 from nmsm.tools.gcp.filtering import lowpass
 from nmsm.tools.gcp.foot_model import FOOT_COORDINATES

@@ -17,10 +17,11 @@ block                           name                  bounds            scale
 ``forcePlateRotation``          plate_rotation_<foot> +-0.2618 rad      (range)
 ==============================  ====================  ================  =========
 
-``<foot>`` is the 1-based foot index. Solved with the least-squares back end (scipy
-``least_squares`` 'trf', exact sparse CasADi Jacobians, LSMR trust-region steps: the
-Jacobian has ~40 times more rows than columns and an SVD of it per iteration costs more
-than the Jacobian itself, for the same steps here): ``function_tolerance`` -> ``ftol``,
+``<foot>`` is the 1-based foot index. Solved by :func:`nmsm.tools.gcp.solver.solve_task`
+(scipy ``least_squares`` 'trf', exact sparse Jacobians through the lifted foot
+coordinates, LSMR trust-region steps: the Jacobian has ~40 times more rows than columns
+and an SVD of it per iteration costs more than the Jacobian itself, for the same steps
+here). Options from the settings: ``function_tolerance`` -> ``ftol``,
 ``step_tolerance`` -> ``xtol``, ``optimality_tolerance`` -> ``gtol``, ``max_iterations``
 -> the number of residual evaluations (each trust-region iteration evaluates the residuals
 once and the Jacobian once per accepted step). ``diff_min_change`` (a finite-difference
@@ -42,7 +43,7 @@ from nmsm.io.settings.gcp import GcpTask, GroundContactPersonalizationSettings
 from nmsm.tools.gcp.context import GcpContext
 from nmsm.tools.gcp.inputs import FootInputs
 from nmsm.tools.gcp.state import Design, GcpState
-from nmsm.tools.gcp.values import FootValues, foot_values
+from nmsm.tools.gcp.values import FootValues, foot_coordinates, foot_values
 
 #: bound of the force-plate rotation (rad), 15 degrees
 PLATE_ROTATION_BOUND = 0.2618
@@ -51,13 +52,19 @@ _AXES = "xyz"
 
 @attrs.frozen(eq=False)
 class TaskProblem:
-    """A built task: the problem, its context (for terms) and the modeled values."""
+    """A built task: the problem, its context (for terms) and the modeled values.
+
+    ``lifted`` maps problem parameters standing for foot coordinates (``q_<foot>``,
+    ``qdot_<foot>``, (7, T)) to their expressions of the design variables; they must equal
+    those expressions wherever the problem is evaluated (:mod:`nmsm.tools.gcp.solver`).
+    """
 
     problem: OptimizationProblem
     context: GcpContext
     values: list[FootValues]
     design: Design
     terms: list[Term]
+    lifted: dict[str, Any] = attrs.field(factory=dict)
 
 
 def _scalar(problem: OptimizationProblem, optimize: bool, name: str, value: float, **kw: Any) -> Any:
@@ -97,15 +104,30 @@ def build_design(problem: OptimizationProblem, state: GcpState, flags: dict[str,
 
 
 def build_task_problem(feet: Sequence[FootInputs], state: GcpState, task: GcpTask, terms: Sequence[Term],
-                       *, name: str = "gcp_task") -> TaskProblem:
-    """The task's problem with ``terms`` (registered GCP cost terms) added."""
+                       *, name: str = "gcp_task", lift: bool = True) -> TaskProblem:
+    """The task's problem with ``terms`` (registered GCP cost terms) added.
+
+    With ``lift`` and optimized kinematics, each foot's coordinates and rates enter the
+    terms through parameters ``q_<foot>``/``qdot_<foot>`` (see :class:`TaskProblem`).
+    """
     problem = OptimizationProblem(name)
     design = build_design(problem, state, task.design_flags)
-    values = [foot_values(foot, design, i) for i, foot in enumerate(feet)]
+    lifted: dict[str, Any] = {}
+    values = []
+    for i, foot in enumerate(feet):
+        q, qdot = foot_coordinates(foot, design.coefficients[i])
+        if lift and task.design_flags["kinematicsBSplineCoefficients"]:
+            numeric = foot_coordinates(foot, cs.DM(state.coefficients[i]))
+            lifted[f"q_{foot.index}"], lifted[f"qdot_{foot.index}"] = q, qdot
+            coordinates = (problem.parameter(f"q_{foot.index}", np.array(numeric[0])),
+                           problem.parameter(f"qdot_{foot.index}", np.array(numeric[1])))
+            values.append(foot_values(foot, design, i, coordinates=coordinates))
+        else:
+            values.append(foot_values(foot, design, i, coordinates=(q, qdot)))
     context = GcpContext(feet, values, design, task.neighborStandardDeviation)
     for term in terms:
         problem.add_term(term, context)
-    return TaskProblem(problem, context, values, design, list(terms))
+    return TaskProblem(problem, context, values, design, list(terms), lifted)
 
 
 def solver_options(settings: GroundContactPersonalizationSettings, max_iterations: int | None = None) -> dict[str, Any]:
@@ -116,7 +138,6 @@ def solver_options(settings: GroundContactPersonalizationSettings, max_iteration
         "xtol": settings.step_tolerance,
         "gtol": settings.optimality_tolerance,
         "max_nfev": int(min(iterations, settings.max_function_evaluations)),
-        "tr_solver": "lsmr",
     }
 
 

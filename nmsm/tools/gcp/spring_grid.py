@@ -17,8 +17,12 @@ toes joint at 0, heights ignored):
    marker to the toe marker, columns from the medial to the lateral marker line.
 3. A point is kept when it lies inside the sole outline :data:`SOLE_OUTLINE`: for each
    ``b`` an interval ``[a_min(b), a_max(b)]`` (linear in ``b`` between the table's rows):
-   a narrower rounded heel, the medial arch cut, the full width at the ball of the foot
-   (where the medial and lateral forefoot markers are), toes tapering on the lateral side.
+   a narrower heel, the medial arch cut, the full width at the ball of the foot (where the
+   medial and lateral forefoot markers are), toes tapering on the lateral side. The rows
+   cover the whole sole from the heel to the toe marker. About 85 % of the grid is kept
+   (5 x 11: 47 springs, 8 x 15: 106, 5 x 15: 65; the original's shoe outline keeps 37, 83
+   and 55 and starts about 10 % of the foot length ahead of the heel marker; a tighter
+   outline of that kind gave worse fits of the tutorial in 20 iterations).
 4. Height: every spring sits at ``y = -(hindfoot origin height in the model's default
    pose)`` in the hindfoot frame (tools.md §6.2), i.e. on the floor in the default pose.
 5. Points beyond the toes joint axis (on the toe side of the axis line in the x-z plane)
@@ -71,7 +75,7 @@ def inside_outline(a: np.ndarray, b: np.ndarray, outline: np.ndarray = SOLE_OUTL
     lo = np.interp(b, outline[:, 0], outline[:, 1])
     hi = np.interp(b, outline[:, 0], outline[:, 2])
     eps = 1e-9
-    return (a >= lo - eps) & (a <= hi + eps) & (b >= -eps) & (b <= 1 + eps)
+    return (a >= lo - eps) & (a <= hi + eps) & (b >= outline[0, 0] - eps) & (b <= outline[-1, 0] + eps)
 
 
 def normalized_grid(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:

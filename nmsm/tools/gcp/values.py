@@ -73,11 +73,20 @@ def experimental_reactions(foot: FootInputs, resting_length: Any, shift: Any, th
     return cs.mtimes(rotation, forces), cs.mtimes(rotation, moments)
 
 
-def foot_values(foot: FootInputs, design: Design, index: int) -> FootValues:
-    """The :class:`FootValues` of ``foot`` (position ``index`` in the design's foot lists)."""
-    nodes = cs.DM(foot.base_nodes) * design.coefficients[index]
-    q = cs.mtimes(sparse_dm(foot.basis), nodes).T
-    qdot = cs.mtimes(sparse_dm(foot.basis_rate), nodes).T
+def foot_coordinates(foot: FootInputs, coefficients: Any) -> tuple[Any, Any]:
+    """``(q, qdot)`` (7, T) of the foot for kinematic coefficients ``coefficients`` (m, 7)."""
+    nodes = cs.DM(foot.base_nodes) * coefficients
+    return cs.mtimes(sparse_dm(foot.basis), nodes).T, cs.mtimes(sparse_dm(foot.basis_rate), nodes).T
+
+
+def foot_values(foot: FootInputs, design: Design, index: int, *, coordinates: tuple[Any, Any] | None = None
+                ) -> FootValues:
+    """The :class:`FootValues` of ``foot`` (position ``index`` in the design's foot lists).
+
+    ``coordinates``: ``(q, qdot)`` (7, T) to use instead of :func:`foot_coordinates` of the
+    design's coefficients (symbols standing for them: see :mod:`nmsm.tools.gcp.solver`).
+    """
+    q, qdot = coordinates if coordinates is not None else foot_coordinates(foot, design.coefficients[index])
     frames = foot.n_frames
     mapped = foot.frame_function.map("frames", "thread", frames, [], [], MAP_OPTIONS)
     parameters = design.contact_parameters(foot.surface.belt_speed)

@@ -52,3 +52,30 @@ def _hessian(expression: cs.MX, x: cs.MX) -> cs.MX:
         return cs.MX(x.numel(), x.numel())
     h, _ = cs.hessian(expression, x)
     return h
+
+
+def gauss_newton_hessian(problem: OptimizationProblem) -> dict[str, Any]:
+    """``hess_lag`` with the Gauss-Newton objective Hessian ``2 lam_f J^T J`` (``J`` = residual Jacobian).
+
+    For sum-of-squares objectives (MTLI): only first derivatives of the residuals are needed,
+    so building and evaluating it is much cheaper than the exact Hessian; IPOPT still
+    converges (the Gauss-Newton matrix is positive semi-definite). Constraint Hessians, if
+    any, stay exact (block-wise).
+    """
+    x = problem.scaled_vector()
+    p = problem.parameter_vector()
+    g, _, _ = problem.constraint_vector()
+    lam_f = cs.MX.sym("lam_f")
+    lam_g = cs.MX.sym("lam_g", g.numel())
+    jac = cs.jacobian(problem.residual_vector(), x)
+    hess = 2 * lam_f * cs.mtimes(jac.T, jac)
+    start = 0
+    for c in problem.constraints:
+        n = c.expression.numel()
+        if n:
+            hess = hess + _hessian(cs.dot(lam_g[start : start + n], c.expression), x)
+        start += n
+    hess_lag = cs.Function(
+        "nlp_hess_l", [x, p, lam_f, lam_g], [cs.triu(hess)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+    )
+    return {"hess_lag": hess_lag}

@@ -15,9 +15,11 @@ block                                 unit       init    bounds
 ``synergy_weights`` (SynX)            -          0       [-100, 100]
 ====================================  =========  ======  ==============
 
-Nonlinear inequalities per muscle (soft maximum over trials and frames, k = 500):
-``log(sum(exp(k (l - 1.3)))) / k <= 0`` and ``log(sum(exp(k (0.3 - l)))) / k <= 0``; with
-SynX the extrapolated (unscaled) excitations are bounded to [0, 1] (linear).
+Normalized fiber lengths stay in [0.3, 1.3]: by default bounded frame by frame; the
+original's per-muscle soft maximum over trials and frames (k = 500),
+``log(sum(exp(k (l - 1.3)))) / k <= 0`` and ``log(sum(exp(k (0.3 - l)))) / k <= 0``, is
+available (``fiber_length_limits="softmax"``). With SynX the extrapolated (unscaled)
+excitations are bounded to [0, 1] (linear).
 """
 
 from __future__ import annotations
@@ -169,14 +171,20 @@ def build_task_problem(
     chains: Sequence[TrialChain] | None = None,
     name: str = "MTP task",
     lift: bool = True,
+    fiber_length_limits: str = "frames",
 ) -> tuple[OptimizationProblem, MtpContext]:
     """The task's problem (variables, terms, constraints) and the terms' context.
 
-    ``lift``: activations become decision variables (``activations_<trial>``,
-    ``synx_activations_<trial>``) with equality constraints to the modeled ones. The
-    solution is the same; exact Jacobians and Hessians stay sparse (the moments couple
-    all muscles only through the linear sum of forces), which makes IPOPT with exact
-    second derivatives fast.
+    ``lift``: tendon forces and moments become decision variables (``tendon_forces_<trial>``,
+    ``moments_<trial>``, with SynX also ``synx_...``) with equality constraints to the
+    modeled ones. The solution is the same; exact Jacobians and Hessians stay sparse (the
+    moments couple all muscles only through the linear sum of forces), which makes IPOPT
+    with exact second derivatives fast.
+
+    ``fiber_length_limits``: ``"frames"`` bounds every normalized fiber length to
+    [0.3, 1.3] (smooth, well conditioned); ``"softmax"`` is the original's per-muscle soft
+    maximum with sharpness 500 (stricter by at most ``log(n_trials n_frames) / 500``), whose
+    gradients grow 500-fold near the limit and stall IPOPT on patient data.
     """
     problem = OptimizationProblem(name)
     m = data.muscles.n_muscles
@@ -191,7 +199,8 @@ def build_task_problem(
     weights: Any = cs.MX(0, 1)
     if data.synx is not None:
         low, high = SYNERGY_WEIGHT_BOUNDS
-        weights = problem.variable("synergy_weights", np.clip(state.synergy_weights, low, high), low, high)
+        # scale 1: typical weights are O(0.1-1), far below the +-100 bounds
+        weights = problem.variable("synergy_weights", np.clip(state.synergy_weights, low, high), low, high, scale=1.0)
     chains = list(chains) if chains is not None else data.chains()
     lifted = lifted_synx = None
     if lift:
@@ -221,9 +230,16 @@ def build_task_problem(
     if data.synx is not None:
         for term in task.synx_terms:
             problem.add_term(term, ctx)
-    upper, lower = fiber_length_constraints(plain)
-    problem.add_constraint("normalized_fiber_length_max_1.3", upper, -np.inf, 0.0)
-    problem.add_constraint("normalized_fiber_length_min_0.3", lower, -np.inf, 0.0)
+    if fiber_length_limits == "softmax":
+        upper, lower = fiber_length_constraints(plain)
+        problem.add_constraint("normalized_fiber_length_max_1.3", upper, -np.inf, 0.0)
+        problem.add_constraint("normalized_fiber_length_min_0.3", lower, -np.inf, 0.0)
+    elif fiber_length_limits == "frames":
+        for model in plain:
+            problem.add_constraint(f"normalized_fiber_length_{model.name}", model.normalized_fiber_length,
+                                   CONSTRAINT_MIN_LENGTH, CONSTRAINT_MAX_LENGTH)
+    else:
+        raise ValueError(f"fiber_length_limits must be 'frames' or 'softmax', got '{fiber_length_limits}'")
     if data.synx is not None and data.synx.method == "PCA":
         problem.add_constraint("extrapolated_excitation_0_1", data.synx.extrapolated_bounds_expression(weights), 0.0, 1.0)
     return problem, ctx
@@ -232,39 +248,49 @@ def build_task_problem(
 def _lift(
     problem: OptimizationProblem, data: MtpData, state: MtpState, chains: Sequence[TrialChain]
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]] | None]:
-    """Lifted variables per trial (activations, tendon forces, moments) at ``state``'s values.
+    """Lifted variables per trial (tendon forces, moments) at ``state``'s values.
 
-    Every lifting equality then depends on one muscle's parameters at one frame
-    (activations, forces) or on one frame's forces (moments, linear): exact Jacobians and
-    Hessians need few colours (see :mod:`nmsm.tools.mtp.derivatives`).
+    Every lifting equality then depends on one muscle's parameters at one frame (forces)
+    or on one frame's forces (moments, linear): exact Jacobians and Hessians need few
+    colours (see :mod:`nmsm.tools.mtp.derivatives`). Forces are scaled by each muscle's
+    ``F0 cos(alpha)`` and moments by each coordinate's largest ID moment, variables and
+    equality rows alike, so all lifted quantities are O(1). (Activations are not lifted:
+    their rows share the activation parameters and synergy weights, which only adds
+    variables and fill-in.)
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
-    fields = ("activations", "tendon_force", "moments")
+    fields = ("tendon_force", "moments")
     models = plain + (synx or [])
     values = cs.Function("lift_start", [], [getattr(m, f) for m in models for f in fields]).call([])
+    force_scale = (data.muscles.max_isometric_force * np.cos(data.muscles.pennation_angle)).reshape(1, -1)
     out: list[dict[str, Any]] = []
     for i, model in enumerate(models):
-        a, force, mom = (np.array(values[i * len(fields) + j].full()) for j in range(len(fields)))
+        force, mom = (np.array(values[i * len(fields) + j].full()) for j in range(len(fields)))
         prefix = "" if i < len(plain) else "synx_"
-        force_scale = np.maximum(np.abs(force).max(axis=0), 1.0).reshape(1, -1)
-        moment_scale = np.maximum(np.abs(mom).max(axis=0), 1.0).reshape(1, -1)
+        trial = data.trials[i % len(plain)]
+        moment_scale = np.maximum(np.abs(trial.inverse_dynamics_moments).max(axis=0), 1.0).reshape(1, -1)
         out.append({
-            "activations": problem.variable(f"{prefix}activations_{model.name}", a, scale=1.0),
             "forces": problem.variable(f"{prefix}tendon_forces_{model.name}", force, scale=force_scale),
             "moments": problem.variable(f"{prefix}moments_{model.name}", mom, scale=moment_scale),
+            "force_scale": force_scale,
+            "moment_scale": moment_scale,
         })
     return out[: len(plain)], (out[len(plain) :] if synx is not None else None)
 
 
 def _lifting_constraints(problem: OptimizationProblem, models: Sequence[TrialModel],
                          lifted: Sequence[dict[str, Any]], prefix: str) -> None:
-    """Equalities tying lifted variables to the modeled quantities (forces scaled to ~1)."""
+    """Equalities tying lifted variables to the modeled quantities (rows scaled to O(1))."""
     for model, values in zip(models, lifted):
         name = model.name
-        problem.add_constraint(f"lifted_{prefix}activations_{name}", values["activations"] - model.modeled_activations, 0.0, 0.0)
-        problem.add_constraint(f"lifted_{prefix}forces_{name}", values["forces"] - model.modeled_tendon_force, 0.0, 0.0)
-        problem.add_constraint(f"lifted_{prefix}moments_{name}", values["moments"] - model.modeled_moments, 0.0, 0.0)
+        n = int(model.activations.shape[0])
+        force_rows = cs.DM(np.repeat(1.0 / values["force_scale"], n, axis=0))
+        moment_rows = cs.DM(np.repeat(1.0 / values["moment_scale"], n, axis=0))
+        problem.add_constraint(f"lifted_{prefix}forces_{name}",
+                               (values["forces"] - model.modeled_tendon_force) * force_rows, 0.0, 0.0)
+        problem.add_constraint(f"lifted_{prefix}moments_{name}",
+                               (values["moments"] - model.modeled_moments) * moment_rows, 0.0, 0.0)
 
 
 def updated_state(state: MtpState, values: dict[str, np.ndarray]) -> MtpState:

@@ -13,8 +13,11 @@ Modules (one job each):
 ``state``             ``pipeline_state.json``: records of finished stages
 ``outputs``           where each kind of stage leaves its outputs
 ``runner``            running a pipeline, skipping up-to-date stages, resuming after a stop
+``native``            reading the pipeline's own settings files (and ``nmsm run`` on them)
 ``analysis*``         the analysis stage: IK, ID and muscle analysis on the current model
-``cli``               the command-line sub-commands
+``preprocess*``       the preprocessing stage: full-length trials cut into the tools' trials
+``surrogate*``        the surrogate-data stage: sampled poses and their muscle analysis
+``cli``               ``nmsm pipeline``, ``nmsm example``, ``nmsm report``, ``nmsm export``
 
 Importing this package imports neither CasADi nor OpenSim.
 """

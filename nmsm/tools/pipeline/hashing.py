@@ -7,8 +7,11 @@ results tree that was moved (or a data folder copied elsewhere) is still up to d
 * a file: SHA-256 of its bytes;
 * a folder: SHA-256 over its files in sorted relative-path order, each as
   ``relative path`` + the file's digest; hidden entries (``.staging-*`` folders of
-  :class:`~nmsm.core.results.ResultsDirectory`, ``.nmsm`` records) are left out;
-* a missing path: the text ``missing:<name>`` (so a file that appears later changes it).
+  :class:`~nmsm.core.results.ResultsDirectory`) and ``plots`` folders (figures drawn from
+  the results, e.g. by ``nmsm report``) are left out;
+* a missing path: the text ``missing:<name>`` (so a file that appears later changes it);
+* nmsm's own code: :func:`code_digest` over its Python sources (part of every stage's
+  input digest, so results made by another version of nmsm are redone).
 
 Digests are hex strings. Files are read in 1 MiB blocks; :class:`DigestCache` remembers the
 digest of a file by ``(path, size, mtime_ns)`` within one pipeline run, so a data folder
@@ -23,6 +26,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 _BLOCK = 1 << 20
+#: folders of figures drawn from results (``nmsm plot``, ``nmsm report``): derived, not hashed
+FIGURES = "plots"
 
 
 def _is_hidden(name: str) -> bool:
@@ -80,7 +85,8 @@ def _visible_files(root: Path, exclude: set[Path]) -> Iterable[tuple[str, Path]]
     found: list[tuple[str, Path]] = []
     for folder, dirs, files in os.walk(root):
         base = Path(folder)
-        dirs[:] = sorted(d for d in dirs if not _is_hidden(d) and (base / d).resolve() not in exclude)
+        dirs[:] = sorted(d for d in dirs if not _is_hidden(d) and d != FIGURES
+                         and (base / d).resolve() not in exclude)
         for name in files:
             if _is_hidden(name):
                 continue
@@ -88,6 +94,29 @@ def _visible_files(root: Path, exclude: set[Path]) -> Iterable[tuple[str, Path]]
             found.append((file.relative_to(root).as_posix(), file))
     found.sort(key=lambda item: item[0])
     return found
+
+
+_CODE_DIGEST: str | None = None
+#: packages of nmsm that cannot change a stage's results (examples write settings, which are hashed)
+_NOT_RESULTS = ("examples", "report", "plots")
+
+
+def code_digest() -> str:
+    """SHA-256 (hex) of nmsm's own Python sources (but :data:`_NOT_RESULTS`): a stage made by
+    other code is redone (after an upgrade, or while developing nmsm)."""
+    global _CODE_DIGEST
+    if _CODE_DIGEST is None:
+        import nmsm
+
+        root = Path(nmsm.__file__).resolve().parent
+        digest = hashlib.sha256()
+        for file in sorted(root.rglob("*.py")):
+            if file.relative_to(root).parts[0] in _NOT_RESULTS:
+                continue
+            digest.update(file.relative_to(root).as_posix().encode())
+            digest.update(file.read_bytes())
+        _CODE_DIGEST = digest.hexdigest()
+    return _CODE_DIGEST
 
 
 def text_digest(*parts: str) -> str:

@@ -129,7 +129,8 @@ _BUILT_IN = (
               "nmsm.io.settings.ncp:NeuralControlPersonalizationSettings", "nmsm.tools.ncp.run:run_settings",
               _OUT + "ncp_outputs", requires=("model", "data_directory"), uses=("osimx", "mtp_results"),
               produces=("osimx", "ncp_results"),
-              wires=(*_PERSONALIZATION_WIRES, Wire("mtp_results", "mtp_results_directory"))),
+              wires=(*_PERSONALIZATION_WIRES, Wire("mtp_results", "mtp_results_directory")),
+              run_options={"print_level": 0}),
     StageKind("gcp", "Ground Contact Personalization", "GroundContactPersonalizationTool", 60,
               "nmsm.io.settings.gcp:GroundContactPersonalizationSettings", "nmsm.tools.gcp.run:run_settings",
               _OUT + "gcp_outputs", requires=("model", "data_directory"), uses=("osimx",),
@@ -148,7 +149,7 @@ _BUILT_IN = (
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
                      Wire("data_directory", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess"),
+              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", run_options={"print_level": 0}),
     StageKind("vo", "Verification Optimization", "VerificationOptimizationTool", 90,
               _TREATMENT_SETTINGS + "VerificationOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -156,7 +157,8 @@ _BUILT_IN = (
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
-                     Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True))),
+                     Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
+              run_options={"print_level": 0}),
     StageKind("do", "Design Optimization", "DesignOptimizationTool", 100,
               _TREATMENT_SETTINGS + "DesignOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -164,7 +166,8 @@ _BUILT_IN = (
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
-                     Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True))),
+                     Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
+              run_options={"print_level": 0}),
 )
 
 _REGISTRY: dict[str, StageKind] = {kind.tool_element: kind for kind in _BUILT_IN}

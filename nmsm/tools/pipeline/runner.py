@@ -5,7 +5,8 @@ For each enabled stage, in order:
 1. read its settings (file or embedded; old schemas upgraded), rewire its inputs to the
    artifacts available so far (:mod:`nmsm.tools.pipeline.wiring`), point its
    ``results_directory`` at ``<results>/<stage name>/`` and make every other path absolute;
-2. hash its inputs (settings plus the contents of every file and folder they name);
+2. hash its inputs (settings plus the contents of every file and folder they name, and
+   nmsm's own code);
 3. if ``pipeline_state.json`` records that digest and the recorded outputs are unchanged,
    skip it ("up to date"); otherwise write ``<results>/<stage name>.xml`` (a settings file
    ``nmsm run`` accepts), empty the stage's folder, run the tool on that file, find its
@@ -36,7 +37,7 @@ import attrs
 
 from nmsm.errors import InputError
 from nmsm.tools.pipeline.artifacts import Artifacts
-from nmsm.tools.pipeline.hashing import DigestCache
+from nmsm.tools.pipeline.hashing import DigestCache, code_digest
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
 from nmsm.tools.pipeline.plan import check_inputs, check_order
 from nmsm.tools.pipeline.stage_settings import StageSettings
@@ -176,7 +177,7 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
             say(f"{head}: disabled")
             continue
         settings, wired = prepare_stage(stage, artifacts, results)
-        digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}")
+        digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}", code_digest())
         record = state.records.get(stage.name)
         current = (record is not None and record.input_digest == digest and record.kind == stage.kind.code
                    and stage.name not in forced and _outputs_intact(record, results, cache))

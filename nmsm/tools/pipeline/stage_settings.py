@@ -204,12 +204,19 @@ class StageSettings:
         work = StageSettings(tree, self.origin, self.settings_class)
         folder = settings_file.resolve().parent
         root = results_root.resolve()
+        changes = []  # collected first: a base element's new text must not change how others resolve
         for field in work.path_fields():
             if field.element is None or not (field.element.text or "").strip():
                 continue
             value = Path(normalize_separators(field.element.text))
-            if value.is_absolute() and _is_within(value.resolve(), root):
-                field.element.text = Path(os.path.relpath(value.resolve(), folder)).as_posix()
+            if not value.is_absolute() or not _is_within(value.resolve(), root):
+                continue
+            relative_to = field.base.resolve() if field.spec.base and field.base is not None else folder
+            if field.spec.base and not _is_within(value.resolve(), relative_to):
+                continue  # keep absolute: relative text would be read against the base folder
+            changes.append((field.element, Path(os.path.relpath(value.resolve(), relative_to)).as_posix()))
+        for element, text in changes:
+            element.text = text
         etree.indent(tree, space="  ")
         return etree.tostring(tree, pretty_print=True, xml_declaration=True, encoding="UTF-8").decode()
 

@@ -152,6 +152,25 @@ class GridView:
     def tracked_body_orientation(self, body: str, sequence: str = "xyz") -> cs.MX:
         return self._q.tracked_orientation(self.grid, body, check_sequence(sequence))
 
+    # ---- ground contact -----------------------------------------------------------------------
+    def ground_reaction_force(self, label: str) -> cs.MX:
+        """(n, 1) modeled ground reaction component named by a force column (N)."""
+        contact, kind, axis = self._q.find_reaction(label)
+        return self._q.ground_reaction(self.grid, contact)[0][:, axis]
+
+    def ground_reaction_moment(self, label: str) -> cs.MX:
+        """(n, 1) modeled moment component (N·m) about the contact model's reference point."""
+        contact, kind, axis = self._q.find_reaction(label)
+        return self._q.ground_reaction(self.grid, contact)[1][:, axis]
+
+    def tracked_ground_reaction_force(self, label: str) -> cs.DM:
+        contact, kind, axis = self._q.find_reaction(label)
+        return self._q.tracked_reaction(self.grid, contact)[0][:, axis]
+
+    def tracked_ground_reaction_moment(self, label: str) -> cs.DM:
+        contact, kind, axis = self._q.find_reaction(label)
+        return self._q.tracked_reaction(self.grid, contact)[1][:, axis]
+
     # ---- controls and muscles ------------------------------------------------------------
     def control(self, name: str) -> cs.MX:
         return self._q.control(self.grid, name)
@@ -361,6 +380,23 @@ class TreatmentContext(GridView):
             raise term.error(f"'{name}' is not a synergy of the synergy controller", element=element,
                              expected="one of " + (", ".join(names) or "(no synergy controller)"))
 
+    def require_reaction(self, term: Any, label: str, kind: str, element: str) -> None:
+        """``label`` must be a ``kind`` ('force' | 'moment') column of a contact model, and the
+        tracked GRF file must have it when the term tracks it."""
+        try:
+            _, found, _ = self._q.find_reaction(label)
+        except KeyError:
+            labels = [x for c in self._q.data.contact_models for x in getattr(c, f"{kind}_labels")]
+            raise term.error(f"'{label}' is not a {kind} column of the contact surfaces", element=element,
+                             expected="one of " + (", ".join(labels) or "(no contact model: add contact surfaces "
+                                                   "to the .osimx or contact forces to the model)")) from None
+        if found != kind:
+            raise term.error(f"'{label}' is a {found} column, not a {kind} column", element=element)
+
+    def has_tracked_ground_reaction(self, label: str) -> bool:
+        refs = self._q.data.references.get("ground_reactions")
+        return refs is not None and refs.has(label)
+
     def require_parameter(self, term: Any, name: str, element: str = "<type>") -> None:
         if name not in self._q.data.parameters:
             raise term.error(f"static parameter '{name}' is not declared in <RCNLParameterTermSet>", element=element,
@@ -543,10 +579,78 @@ class _Quantities:
     # ---- inverse dynamics -------------------------------------------------------------------
     def inverse_dynamics(self, grid: str) -> cs.MX:
         def compute() -> cs.MX:
-            f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
-            (tau,) = self.map_point(f, grid)
+            contacts = self.data.contact_models
+            if not contacts:
+                f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
+                (tau,) = self.map_point(f, grid)
+                return tau
+            f = self.composed("inverse_dynamics_contact", self._contact_inverse_dynamics_function())
+            (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts])
             return tau
         return self.cache((grid, "inverse_dynamics"), compute)
+
+    def _contact_function(self, contact: Any) -> cs.Function:
+        return self.cache(("contact_function", id(contact)), lambda: contact.point_function(self.data.model))
+
+    def _contact_inverse_dynamics_function(self) -> cs.Function:
+        """SX ``(q, qd, qdd, p_1, ..., p_m) -> tau`` with every contact model's loads."""
+        def compute() -> cs.Function:
+            model = self.data.model
+            contacts = self.data.contact_models
+            bodies = tuple(b for c in contacts for b in c.load_bodies)
+            nq = len(model.coordinate_names)
+            q, qd, qdd = (cs.SX.sym(n, nq) for n in ("q", "qd", "qdd"))
+            params, loads = [], []
+            for c in contacts:
+                f = self._contact_function(c)
+                p = cs.SX.sym("p", f.size1_in(2))
+                params.append(p)
+                loads.append(f(q, qd, p)[0])
+            tau = model.inverse_dynamics_function(bodies)(q, qd, qdd, cs.horzcat(*loads))
+            return cs.Function("inverse_dynamics_contact", [q, qd, qdd, *params], [tau])
+        return self.cache(("contact_inverse_dynamics_function",), compute)
+
+    def ground_reaction(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
+        """(force, moment about the point, point), each (n, 3), ground, of one contact model."""
+        def compute() -> tuple[cs.MX, cs.MX, cs.MX]:
+            f = self._contact_function(contact)
+            nq = len(self.data.model.coordinate_names)
+            q, qd = cs.SX.sym("q", nq), cs.SX.sym("qd", nq)
+            p = cs.SX.sym("p", f.size1_in(2))
+            _, force, moment, point = f(q, qd, p)
+            g = cs.Function(f"ground_reaction_{contact.name}", [q, qd, p], [force, moment, point])
+            composed = self.composed(("ground_reaction", id(contact)), g, "q, qd")
+            force, moment, point = self.map_point(composed, grid, contact.parameters())
+            return force, moment, point
+        return self.cache((grid, "ground_reaction", id(contact)), compute)
+
+    def find_reaction(self, label: str) -> tuple[Any, str, int]:
+        """(contact model, 'force'|'moment'|'point', axis index) of a ground reaction column."""
+        for c in self.data.contact_models:
+            for kind, labels in (("force", c.force_labels), ("moment", c.moment_labels), ("point", c.point_labels)):
+                if label in labels:
+                    return c, kind, list(labels).index(label)
+        raise KeyError(f"'{label}' is not a ground reaction column of the contact models")
+
+    def tracked_reaction(self, grid: str, contact: Any) -> tuple[cs.DM, cs.DM, cs.DM]:
+        """Experimental (force, moment about the modeled reference point, electrical centre),
+        each (n, 3): ``M = T + (EC - P) x F`` with ``P`` the midfoot reference on the tracked
+        kinematics (the tracked GRF file's torques ``T`` act at ``EC``)."""
+        def compute() -> tuple[cs.DM, cs.DM, cs.DM]:
+            refs = self.data.references["ground_reactions"]
+            t = self.reference_times(grid)
+            force = refs.values(t, 0, contact.force_labels)
+            torque = refs.values(t, 0, contact.moment_labels)
+            centre = refs.values(t, 0, contact.point_labels)
+            q, qd, _ = self.data.tracked_full_kinematics(t)
+            f = self._contact_function(contact)
+            # the reference point's x and z do not depend on the contact parameters
+            rows = f.map(q.shape[0])(q.T, qd.T, cs.DM.zeros(f.size1_in(2), q.shape[0]))
+            point = np.asarray(rows[3]).T
+            reference = np.c_[point[:, 0], np.zeros(len(t)), point[:, 2]]
+            moment = torque + np.cross(centre - reference, force)
+            return cs.DM(force), cs.DM(moment), cs.DM(centre)
+        return self.cache((grid, "tracked_reaction", id(contact)), compute)
 
     def tracked_load_label(self, load: str) -> str | None:
         refs = self.data.references.get("loads")
@@ -688,3 +792,4 @@ class _Quantities:
             if getter is not None:
                 return getter(group, initial=initial)
         raise KeyError("no synergy controller in this problem")
+

@@ -3,7 +3,7 @@
 Constraint blocks are the problem's: the collocation defects (equalities) and one block
 per constraint term. For each block: the largest violation of its bounds (in the term's
 scaled units: ``(value - mid)/(max_error - min_error)`` against ``[-0.5, 0.5]``), how many
-rows sit on a bound (active, within 1e-6 of the scaled range) and where the term was
+rows sit on a bound (active, within 1e-5 of the scaled range) and where the term was
 declared (settings file and line).
 """
 
@@ -15,7 +15,7 @@ from nmsm.core.problem import Solution
 from nmsm.tools.treatment.formulation import TreatmentProblem
 
 
-def convergence_summary(built: TreatmentProblem, solution: Solution, *, tol: float = 1e-6) -> str:
+def convergence_summary(built: TreatmentProblem, solution: Solution, *, tol: float = 1e-5) -> str:
     """Human-readable report (text)."""
     lines = [
         f"{built.problem.name}: IPOPT {solution.status} after {solution.iterations} iterations, "
@@ -30,7 +30,7 @@ def convergence_summary(built: TreatmentProblem, solution: Solution, *, tol: flo
     for status, entry in zip(report, built.problem.constraints):
         equality = bool(np.all(entry.lower == entry.upper))
         where = f" ({status.source.file}:{status.source.line})" if status.source and status.source.file else ""
-        flag = "VIOLATED" if status.max_violation > 1e-4 else ("violated" if status.max_violation > tol else "ok")
+        flag = "VIOLATED" if status.max_violation > 1e-4 else ("violated" if status.max_violation > 1e-6 else "ok")
         if equality:
             detail = f"equality, {status.size} rows, max |residual| {status.max_violation:.3g}"
         else:

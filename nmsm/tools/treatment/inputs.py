@@ -83,6 +83,10 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
                          settings_file: Path | None = None) -> TreatmentFiles:
     """Read the tables of ``trial`` (see module docstring)."""
     tracked_dir, initial_dir = Path(tracked_dir), Path(initial_dir)
+    for folder, element in ((tracked_dir, "<tracked_quantities_directory>"), (initial_dir, "<initial_guess_directory>")):
+        if not folder.is_dir():
+            raise InputError(f"folder not found: {folder}", file=settings_file, element=element,
+                             expected="an existing folder")
     ik_folder = tracked_dir / "IKData"
     if not ik_folder.is_dir():
         raise InputError(f"no IKData folder in the tracked quantities directory {tracked_dir}", file=settings_file,

@@ -1,9 +1,8 @@
 """nmsm's OpenSim model (``nmsm.model``) as a :class:`TreatmentModel`.
 
 Inverse dynamics is OpenSim's ID tool's: all muscles disabled, gravity on, no external
-loads (the kicking tutorials have none; ground contact enters later through the contact
-models). Speeds are OpenSim generalized speeds (coordinate rates for the joints the
-tutorials use).
+loads except those of the problem's contact models (``load_bodies``). Speeds are OpenSim
+generalized speeds (coordinate rates for the joints the tutorials use).
 """
 
 from __future__ import annotations
@@ -53,8 +52,10 @@ class OsimTreatmentModel:
     def expand_function(self) -> cs.Function:
         return self.casadi.coordinates.expand
 
-    def inverse_dynamics_function(self) -> cs.Function:
-        return self.casadi.inverse_dynamics_function()
+    def inverse_dynamics_function(self, load_bodies: tuple[str, ...] = ()) -> cs.Function:
+        """``(q, qd, qdd[, loads 9 x k]) -> tau``; ``loads`` (force, point, torque in ground)
+        act on ``load_bodies`` (contact models)."""
+        return self.casadi.inverse_dynamics_function(tuple(load_bodies))
 
     def marker_function(self, marker: str) -> cs.Function:
         return self.casadi.marker_function([marker])

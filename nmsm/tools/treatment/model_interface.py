@@ -36,9 +36,11 @@ class TreatmentModel(Protocol):
         """``(q_ind, qd_ind, qdd_ind) -> (q, qd, qdd)``: independent coordinates (order of
         :attr:`independent_coordinates`) to all coordinates, couplers' chain rule included."""
 
-    def inverse_dynamics_function(self) -> cs.Function:
-        """``(q, qd, qdd) -> tau`` (nq,): generalized forces (N·m or N) that produce ``qdd``
-        with gravity and no muscles (OpenSim's inverse dynamics tool)."""
+    def inverse_dynamics_function(self, load_bodies: tuple[str, ...] = ()) -> cs.Function:
+        """``(q, qd, qdd[, loads]) -> tau`` (nq,): generalized forces (N·m or N) that produce
+        ``qdd`` with gravity and no muscles (OpenSim's inverse dynamics tool); with
+        ``load_bodies``, ``loads`` (9, k) are (force N, point m, torque N·m) in ground applied
+        on those bodies (contact models; models without contact may ignore the argument)."""
 
     def marker_function(self, marker: str) -> cs.Function:
         """``q -> p`` (3,): marker position in ground (m)."""

@@ -4,6 +4,8 @@ Files (``<trial>`` = ``trial_name``):
 
 ``IKData/<trial>.sto``                 every model coordinate (rad, m)
 ``IDData/<trial>.sto``                 inverse dynamics of the solution (N·m, N), ID labels
+``GRFData/<trial>.sto``                modeled ground reactions of the contact models (force N,
+                                       point m, moment N·m about the point; osimx column names)
 ``<trial>_states.sto``                 ``q`` and ``q_u`` of the state coordinates
 ``<trial>_accelerations.sto``          ``q̈`` of the state coordinates
 ``<trial>_torqueControls.sto`` ...     each controller's tables (torque controls, synergy
@@ -47,6 +49,14 @@ def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None 
         write_table(stage / "IKData" / f"{trial}.sto", t, coords, tsol.positions),
         write_table(stage / "IDData" / f"{trial}.sto", t, [model.load_label(c) for c in coords], tsol.inverse_dynamics),
     ]
+    contacts = getattr(data, "contact_models", [])
+    if contacts:
+        labels, columns = [], []
+        for contact in contacts:
+            force, moment, point = (tsol.value(x) for x in built.context._q.ground_reaction(tsol.grid, contact))
+            labels += [*contact.force_labels, *contact.point_labels, *contact.moment_labels]
+            columns += [force, point, moment]
+        out.append(write_table(stage / "GRFData" / f"{trial}.sto", t, labels, np.hstack(columns)))
     sc = data.state_coordinates
     out.append(write_table(stage / f"{trial}_states.sto", t, list(sc) + [speed_label(c) for c in sc], tsol.states))
     out.append(write_table(stage / f"{trial}_accelerations.sto", t, sc, tsol.state_accelerations))

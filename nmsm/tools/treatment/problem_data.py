@@ -39,6 +39,7 @@ class TreatmentData:
     final_time_guess: float
     final_time_bounds: tuple[float, float]
     controllers: list[Any] = attrs.field(factory=list)
+    contact_models: list[Any] = attrs.field(factory=list)
     parameters: dict[str, cs.MX] = attrs.field(factory=dict)
     acceleration_control_offset: int = 0
     #: free final time: scale prescribed coordinates' speeds by T_ref/t_f and accelerations by

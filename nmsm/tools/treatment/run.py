@@ -103,10 +103,25 @@ def objective_scaling_factor(options: TreatmentOptions, initial_cost: float) -> 
     return float(min(max(1.0 / initial_cost, 1e-6), 1e6))
 
 
+#: IPOPT options that keep it at a starting point that already solves the problem
+WARM_START_OPTIONS = {"mu_init": 1e-6, "bound_push": 1e-9, "bound_frac": 1e-9, "slack_bound_push": 1e-9,
+                      "slack_bound_frac": 1e-9}
+
+
+def warm_start_wanted(prepared: Prepared, options: TreatmentOptions) -> bool:
+    """``options.warm_start``, or by default: VO starting from a previous result."""
+    if options.warm_start is not None:
+        return bool(options.warm_start)
+    return prepared.tool == "VO" and "states" in prepared.files.results
+
+
 def _ipopt_kwargs(prepared: Prepared, options: TreatmentOptions, log: Path | None,
                   initial_cost: float = 1.0) -> dict[str, Any]:
     plan = dict(prepared.plan.ipopt)
     extra = dict(options.ipopt_options)
+    if warm_start_wanted(prepared, options):
+        for key, value in WARM_START_OPTIONS.items():
+            extra.setdefault(key, value)
     factor = objective_scaling_factor(options, initial_cost)
     if factor is not None:
         extra.setdefault("obj_scaling_factor", factor)

@@ -52,6 +52,16 @@ def _load_bind(ctx: Any, term: Any) -> None:
     ctx.require_load(term, term.load)
 
 
+def _reaction_bind(kind: str) -> Callable[[Any, Any], None]:
+    def bind(ctx: Any, term: Any) -> None:
+        label = getattr(term, kind)
+        ctx.require_reaction(term, label, kind, f"<{kind}_list>")
+        deviation = "deviation" in term.type or "periodicity" in term.type
+        if deviation and "periodicity" not in term.type and not ctx.has_tracked_ground_reaction(label):
+            raise term.error(f"no column '{label}' in the tracked ground reactions (GRFData)", element=f"<{kind}_list>")
+    return bind
+
+
 SIGNALS: dict[str, Signal] = {
     "generalized_coordinate": Signal(
         "generalized_coordinate", "rad or m", _coordinate_bind,
@@ -74,6 +84,12 @@ SIGNALS: dict[str, Signal] = {
         "body_orientation", "rad", _body_bind,
         lambda v, t: _orientation_column(v.body_orientation(t.body, t.sequence or "xyz"), t),
         lambda v, t: _orientation_column(v.tracked_body_orientation(t.body, t.sequence or "xyz"), t)),
+    "external_force": Signal(
+        "external_force", "N", _reaction_bind("force"),
+        lambda v, t: v.ground_reaction_force(t.force), lambda v, t: v.tracked_ground_reaction_force(t.force)),
+    "external_moment": Signal(
+        "external_moment", "N·m", _reaction_bind("moment"),
+        lambda v, t: v.ground_reaction_moment(t.moment), lambda v, t: v.tracked_ground_reaction_moment(t.moment)),
     "root_segment_residual_load": Signal(
         "root_segment_residual_load", "N·m or N", _load_bind,
         lambda v, t: v.inverse_dynamics_load(t.load)),

@@ -29,7 +29,8 @@ from nmsm.tools.treatment.references import ReferenceSplines
 from nmsm.tools.treatment.solver_options import SolverPlan, plan_from_settings
 
 #: settings attribute of each controller element, in the order controls are laid out
-CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLTorqueController", "torque_controller"))
+CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMuscleController", "muscle_controller"),
+                       ("RCNLTorqueController", "torque_controller"))
 
 
 @attrs.define
@@ -46,7 +47,12 @@ class TreatmentOptions:
     or a number: IPOPT's ``obj_scaling_factor``). ``parallel``: threads for
     the per-point model functions. ``rescale_prescribed_derivatives``: with a free final time,
     scale the prescribed coordinates' speeds and accelerations to the new duration (default;
-    False reproduces the original, which keeps the data's speeds). ``evaluate_only``: build, evaluate the cost at the
+    False reproduces the original, which keeps the data's speeds). ``warm_start``: start IPOPT
+    with a small barrier parameter and bound push (mu_init 1e-6, bound_push/frac 1e-9) so it
+    stays at a starting point that is already a solution; default (None): on for VO when the
+    initial guess folder holds a previous result (``<trial>_states.sto``), as verification
+    should reproduce that motion rather than drift inside the constraint bounds.
+    ``evaluate_only``: build, evaluate the cost at the
     starting point, do not solve.
     """
 
@@ -62,6 +68,7 @@ class TreatmentOptions:
     ipopt_options: dict[str, Any] = attrs.field(factory=dict)
     objective_scaling: str | float = "initial"
     rescale_prescribed_derivatives: bool = True
+    warm_start: bool | None = None
     parallel: int = 1
     evaluate_only: bool = False
     write_results: bool = True
@@ -117,9 +124,11 @@ def _references(files: TreatmentFiles, model: TreatmentModel) -> dict[str, Refer
     if activations is not None:
         refs["activations"] = ReferenceSplines.from_table(activations)
     if files.tracked_grf is not None:
+        # centre-of-pressure columns are NaN in swing, where the force is 0: use 0 there
         table = files.tracked_grf
-        finite = [label for j, label in enumerate(table.labels) if np.all(np.isfinite(table.data[:, j]))]
-        refs["ground_reactions"] = ReferenceSplines.from_table(table, finite)
+        data = np.where(np.isfinite(table.data), table.data, 0.0)
+        time = table.time - table.time[0]
+        refs["ground_reactions"] = ReferenceSplines(time, table.labels, data, str(table.source))
     return refs
 
 
@@ -147,6 +156,14 @@ def _controllers(settings: Any, tool: str, setup: ControllerSetup) -> list[Any]:
             raise InputError(f"no controller plugin handles <{element}> in {tool}", file=settings.settings_file,
                              element=f"<{element}>", expected="an installed controller plugin for this element")
         out.append(cls.from_settings(element_settings, setup))
+    return out
+
+
+def _contact_models(tool: str, setup: ControllerSetup) -> list[Any]:
+    """Every registered contact model's instances in this problem."""
+    out = []
+    for item in get_registry().items("contact", tool):
+        out.extend(item.cls.discover(setup))
     return out
 
 
@@ -238,7 +255,8 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     setup.extras["guess_files"] = guess_files
     controllers = _controllers(settings, tool, setup)
     data = TreatmentData(tool, model, states, refs, refs["coordinates"], t_ref, tf_guess, (lo_t, hi_t),
-                         controllers=controllers, rescale_prescribed_derivatives=options.rescale_prescribed_derivatives)
+                         controllers=controllers, contact_models=_contact_models(tool, setup),
+                         rescale_prescribed_derivatives=options.rescale_prescribed_derivatives)
     state_setup = _state_setup(settings, files, guess_files, states, refs, plan, t_guess)
     problems = check_guess_within("state", tuple(states) + tuple(speed_label(c) for c in states),
                                   state_setup.guess, state_setup.lower, state_setup.upper)

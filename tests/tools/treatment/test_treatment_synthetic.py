@@ -76,3 +76,18 @@ def test_design_optimization_with_free_final_time_meets_a_terminal_goal() -> Non
     velocity = out.value(built.context.final.marker_velocity("tip_1"))[0, 0]
     assert -3.2 - 1e-6 <= velocity <= -3.0 + 1e-6
     assert 0.7 - 1e-9 <= out.final_time <= 1.3 + 1e-9
+
+
+def test_periodicity_with_left_right_mapping() -> None:
+    from nmsm.constraints.treatment.terminal import GeneralizedCoordinatePeriodicity
+
+    term = GeneralizedCoordinatePeriodicity(coordinate="q0", pair_coordinate="q1", min_error=-0.01, max_error=0.01)
+    built = build_case(_to_terms() + [term], guess_scale=1.0)
+    sol = built.problem.solve("ipopt", print_level=0, tol=1e-8)
+    assert sol.success
+    out = TreatmentSolution(built, sol, "periodic")
+    q = out.positions
+    assert abs(q[-1, 0] - q[0, 1]) <= 0.01 + 1e-6
+    # without the mapping the tracked motion ends far from the paired start
+    coords, _ = reference_data(built.data.model)
+    assert abs(coords.values([DURATION], 0, ["q0"])[0, 0] - coords.values([0.0], 0, ["q1"])[0, 0]) > 0.05

@@ -15,7 +15,7 @@ SAMPLE = {
     "coordinate": "q0", "load": "q0_moment", "marker": "tip_1", "axis": "x", "body": "link_1",
     "controller": "q0", "sequence": "xyz",
 }
-NEEDS_MUSCLES = {"muscle", "synergy", "synergies", "synergy_pairs"}
+NEEDS_MUSCLES = {"muscle", "synergy", "synergies", "synergy_pairs", "force", "moment"}  # + contact: own test
 
 
 def _builtin_terms() -> list[type]:

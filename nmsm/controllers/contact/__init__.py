@@ -1,0 +1,1 @@
+"""Built-in contact models (ContactModel plugins), registered by ``nmsm.controllers``."""

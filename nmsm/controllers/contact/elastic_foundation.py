@@ -1,0 +1,83 @@
+"""GCP's elastic-foundation foot contact (spec tools.md §6.3) as a Treatment Optimization contact model.
+
+One instance per ``RCNLContactSurface`` of the ``.osimx`` (springs on the hindfoot and toes
+bodies, from Ground Contact Personalization). Loads go to the hindfoot and toes bodies; the
+ground reaction is reported about the midfoot-superior marker projected on the floor (its
+point written with y = resting spring length, as the original). Parameters (modifiable by
+model functions, e.g. ``applyBeltSpeedParameter``): damping factor, dynamic and viscous friction,
+resting spring length, latching velocity, belt speed (m/s). Formulas:
+:mod:`nmsm.model.foot_contact`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import casadi as cs
+import numpy as np
+
+from nmsm.core.plugin_bases import ContactModel
+from nmsm.model.foot_contact import CONTACT_PARAMETERS, ContactSurfaceModel, contact_function, spring_forces
+
+
+class ElasticFoundationContact(ContactModel):
+    """Spring-grid foot contact of an ``.osimx`` contact surface."""
+
+    type: ClassVar[str] = "elastic_foundation"
+
+    def __init__(self, surface: Any, model: Any, index: int) -> None:
+        self.surface = ContactSurfaceModel.from_osimx(surface, model)
+        self.name = f"surface_{index + 1}"
+        self.is_left_foot = bool(surface.is_left_foot)
+        self.load_bodies = self.surface.bodies
+        self.force_labels = tuple(surface.force_columns)
+        self.moment_labels = tuple(surface.moment_columns)
+        self.point_labels = tuple(surface.electrical_center_columns)
+        self.values: list[Any] = list(self.surface.parameters.vector())
+
+    @classmethod
+    def discover(cls, setup: Any) -> list[ContactModel]:
+        if setup.osimx is None or getattr(setup.model, "model", None) is None:
+            return []
+        from nmsm.io.osimx import read_osimx
+
+        surfaces = read_osimx(setup.osimx).contact_surfaces
+        return [cls(s, setup.model.model, i) for i, s in enumerate(surfaces)]
+
+    def set_parameter(self, name: str, value: Any) -> None:
+        """Replace one of ``CONTACT_PARAMETERS`` (e.g. ``belt_speed``) by a value or MX."""
+        self.values[CONTACT_PARAMETERS.index(name)] = value
+
+    def parameters(self) -> Any:
+        return cs.horzcat(*[cs.MX(v) for v in self.values])
+
+    def point_function(self, model: Any) -> cs.Function:
+        cm = model.casadi
+        surface = self.surface
+        q, qd = cs.SX.sym("q", cm.n), cs.SX.sym("qd", cm.n)
+        p = cs.SX.sym("p", len(CONTACT_PARAMETERS))
+        positions, velocities = [], []
+        for body, location in zip(surface.spring_bodies, surface.spring_locations):
+            point = cs.DM(location)
+            positions.append(cm.point_function(body)(q, point))
+            velocities.append(cm.point_velocity_function(body)(q, qd, point))
+        positions, velocities = cs.horzcat(*positions), cs.horzcat(*velocities)
+        marker = cm.marker_function([surface.midfoot_superior_marker])(q)
+        reference = cs.vertcat(marker[0], 0, marker[2])
+        force, moment, _ = contact_function(surface.n_springs)(positions, velocities, cs.DM(surface.spring_constants),
+                                                               p, reference)
+        forces = spring_forces(positions, velocities, cs.DM(surface.spring_constants), p)
+        columns = []
+        for body in surface.bodies:
+            _, origin = cm.body_pose_function(body)(q)
+            total, torque = cs.SX.zeros(3, 1), cs.SX.zeros(3, 1)
+            for j, spring_body in enumerate(surface.spring_bodies):
+                if spring_body == body:
+                    total = total + forces[:, j]
+                    torque = torque + cs.cross(positions[:, j] - origin, forces[:, j])
+            columns.append(cs.vertcat(total, origin, torque))
+        point = cs.vertcat(marker[0], p[CONTACT_PARAMETERS.index("resting_spring_length")], marker[2])
+        return cs.Function(f"contact_{self.name}", [q, qd, p], [cs.horzcat(*columns), force, moment, point])
+
+    def spring_count(self) -> int:
+        return int(np.size(self.surface.spring_constants))

@@ -1,0 +1,114 @@
+"""``nmsm plot RESULTS_DIR``: the figures of every results folder found in a tree.
+
+The folder itself and every folder below it (``plots`` and hidden folders skipped) is
+tested against each tool's results layout; each match is drawn by the tool's plot module
+(:mod:`nmsm.plots.jmp`, ``mtp``, ``ncp``, ``gcp``, ``treatment``) into ``<folder>/plots``, or
+into ``--output/<folder relative to RESULTS_DIR>``. A pipeline results tree (``nmsm
+pipeline``) gets every stage's figures this way. A folder whose figures fail is reported
+and the others are still drawn (exit code 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import attrs
+
+
+@attrs.frozen
+class Plotter:
+    """A tool's plot module: ``detect(folder) -> bool`` and ``plot(folder, output) -> [paths]``."""
+
+    tool: str
+    module: str
+    plot: str
+    detect: str | None = None  #: the module's own detector, else ``pattern``
+    pattern: str = ""  #: a glob that only the tool's results folders match
+
+    def matches(self, folder: Path) -> bool:
+        module = self._module()
+        if module is None:
+            return False
+        if self.detect and hasattr(module, self.detect):
+            return bool(getattr(module, self.detect)(folder))
+        return bool(self.pattern) and any(folder.glob(self.pattern))
+
+    def draw(self, folder: Path, output: Path | None) -> list[Path]:
+        function: Callable[..., list[Path]] = getattr(self._module(), self.plot)
+        return list(function(folder, output))
+
+    def _module(self) -> Any:
+        try:
+            return importlib.import_module(self.module)
+        except ModuleNotFoundError as exc:
+            if exc.name == self.module:
+                return None
+            raise
+
+
+PLOTTERS = (
+    Plotter("jmp", "nmsm.plots.jmp", "plot_jmp_results", "is_jmp_results"),
+    Plotter("mtp", "nmsm.plots.mtp", "plot_mtp_results", "is_mtp_results"),
+    Plotter("ncp", "nmsm.plots.ncp", "plot_ncp_results", "is_ncp_results"),
+    Plotter("gcp", "nmsm.plots.gcp", "plot_gcp_results", "is_gcp_results", "*_Foot_*_optimizedGroundReactions.sto"),
+    Plotter("treatment", "nmsm.plots.treatment", "plot_treatment_results", "is_treatment_results"),
+)
+
+
+def results_folders(root: str | os.PathLike[str]) -> list[tuple[str, Path]]:
+    """``(tool, folder)`` of every results folder in the tree below ``root`` (``root`` included)."""
+    root = Path(root)
+    found = []
+    for folder, dirs, _ in os.walk(root):
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".") and d != "plots")
+        path = Path(folder)
+        for plotter in PLOTTERS:
+            if plotter.matches(path):
+                found.append((plotter.tool, path))
+    return found
+
+
+def plot_tree(root: str | os.PathLike[str], output: str | os.PathLike[str] | None = None,
+              log: Callable[[str], None] = print) -> tuple[dict[Path, list[Path]], dict[Path, str]]:
+    """Draw every results folder below ``root``; returns (figures per folder, errors per folder)."""
+    from nmsm.errors import NmsmError
+
+    root = Path(root)
+    figures: dict[Path, list[Path]] = {}
+    errors: dict[Path, str] = {}
+    by_tool = {p.tool: p for p in PLOTTERS}
+    for tool, folder in results_folders(root):
+        target = None if output is None else Path(output) / folder.relative_to(root)
+        try:
+            figures[folder] = by_tool[tool].draw(folder, target)
+            log(f"{tool:<10s} {folder}: {len(figures[folder])} figure(s)")
+        except (NmsmError, OSError, ValueError, KeyError) as exc:
+            errors[folder] = f"{type(exc).__name__}: {exc}"
+            log(f"{tool:<10s} {folder}: no figures ({errors[folder]})")
+    return figures, errors
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from nmsm.errors import InputError
+
+    root = Path(args.results)
+    if not root.is_dir():
+        raise InputError("not a folder", file=root, expected="a results folder")
+    figures, errors = plot_tree(root, args.output)
+    if not figures and not errors:
+        print(f"nmsm: no results folder of JMP, MTP, NCP, GCP or treatment optimization in {root}", file=sys.stderr)
+        return 1
+    return 1 if errors else 0
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser("plot", help="figures of every results folder in a tree (PNG)")
+    p.add_argument("results", help="a results folder or a pipeline results tree")
+    p.add_argument("-o", "--output", help="write the figures here (default: <each folder>/plots)")
+    p.set_defaults(func=_plot)

@@ -1,0 +1,95 @@
+"""Sub-commands ``pipeline``, ``example``, ``report`` and ``export``.
+
+::
+
+    nmsm pipeline PIPELINE.xml [--until STAGE] [--only STAGE ...] [--force STAGE ...] [--rebuild] [--check]
+    nmsm example [STAGE] [--folder DIR]            # the built-in synthetic subject, lab data to treatment
+    nmsm report RESULTS_DIR [-o report.html]       # one HTML page with every stage's tables and plots
+    nmsm export OSIMX -o MODEL.osim [--model M.osim] [--no-contact]
+                [--treatment RESULTS_DIR --loads LOADS.xml]   # ExternalLoads of a treatment solution
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+
+def _pipeline(args: argparse.Namespace) -> int:
+    from nmsm.tools.pipeline.runner import run_pipeline_file
+
+    run = run_pipeline_file(args.pipeline, only=args.only or None, until=args.until, force=args.force or (),
+                            rebuild=args.rebuild, check_only=args.check)
+    print(run.summary())
+    return 0
+
+
+def _example(args: argparse.Namespace) -> int:
+    from nmsm.examples.example_run import run_example
+
+    outcome = run_example(args.folder, until=args.stage, rebuild=args.rebuild)
+    print(outcome.text)
+    return 1 if args.strict and not outcome.all_within_tolerance else 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from nmsm.report.html import write_report
+
+    path = write_report(args.results, args.output)
+    print(f"wrote {path}")
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from nmsm.errors import InputError
+    from nmsm.interop.osim_export import export_osimx
+
+    if args.output:
+        report = export_osimx(args.osimx, args.output, model_path=args.model, include_contact=not args.no_contact)
+        print(report.text())
+    if args.treatment:
+        from nmsm.interop.treatment_loads import export_treatment_loads
+
+        if not args.loads:
+            raise InputError("--treatment needs --loads", element="nmsm export", expected="--loads LOADS.xml")
+        xml, data = export_treatment_loads(args.treatment, args.osimx, args.loads, args.trial)
+        print(f"wrote {xml} and {data}")
+    if not args.output and not args.treatment:
+        raise InputError("nothing to export", element="nmsm export", expected="-o MODEL.osim and/or --treatment DIR")
+    return 0
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser("pipeline", help="run a chained pipeline file (stages skipped when up to date)")
+    p.add_argument("pipeline", help="pipeline XML (<PipelineTool>, docs/pipeline.md)")
+    p.add_argument("--until", metavar="STAGE", help="stop after this stage")
+    p.add_argument("--only", metavar="STAGE", nargs="+", help="run only these stages (others must be up to date)")
+    p.add_argument("--force", metavar="STAGE", nargs="+", help="redo these stages even when up to date")
+    p.add_argument("--rebuild", action="store_true", help="redo every stage")
+    p.add_argument("--check", action="store_true", help="check the file and show what would run, run nothing")
+    p.set_defaults(func=_pipeline)
+
+    p = subparsers.add_parser("example", help="the built-in synthetic subject: lab data to treatment, with the "
+                                               "known answers")
+    p.add_argument("stage", nargs="?", help="run the example up to this stage (jmp, analysis, preprocess, mtp, "
+                                            "ncp, gcp, surrogate, to, vo, do); default all")
+    p.add_argument("--folder", default="nmsm_example", help="where the subject and results go (default ./nmsm_example)")
+    p.add_argument("--rebuild", action="store_true", help="regenerate the subject and redo every stage")
+    p.add_argument("--strict", action="store_true", help="exit 1 when a recovered value is out of its tolerance")
+    p.set_defaults(func=_example)
+
+    p = subparsers.add_parser("report", help="one HTML page of every stage's tables and figures in a results tree")
+    p.add_argument("results", help="a pipeline results tree or one tool's results folder")
+    p.add_argument("-o", "--output", help="HTML file (default: RESULTS/report.html)")
+    p.set_defaults(func=_report)
+
+    p = subparsers.add_parser("export", help="a personalized .osimx as a plain OpenSim model; a treatment "
+                                              "solution's ground reactions as ExternalLoads")
+    p.add_argument("osimx", help="the personalized .osimx")
+    p.add_argument("-o", "--output", help="the .osim to write")
+    p.add_argument("--model", help="the .osim to start from (default: the .osimx's associated model)")
+    p.add_argument("--no-contact", action="store_true", help="leave the contact springs out (for ID with ExternalLoads)")
+    p.add_argument("--treatment", metavar="RESULTS_DIR", help="a TO/VO/DO results folder whose GRFData to export")
+    p.add_argument("--loads", metavar="LOADS.xml", help="ExternalLoads XML to write (its .mot next to it)")
+    p.add_argument("--trial", help="trial name in GRFData (default: the only one)")
+    p.set_defaults(func=_export)

@@ -1,0 +1,143 @@
+"""Preprocessing of one recording into the personalization layout (what ``nmsm preprocess`` runs).
+
+Steps (tools.md §2), each optional:
+
+1. raw EMG -> processed EMG (:func:`nmsm.tools.preprocess.emg.process_emg`);
+2. IK from markers, ID from IK (+ external loads), muscle analysis from IK, through nmsm's
+   model core or OpenSim (``engine``), unless the files are given;
+3. muscle-tendon velocity from lengths when the analysis folder has none;
+4. split everything into trials (:func:`nmsm.tools.preprocess.trials.split_into_trials`).
+
+Intermediate files go to ``<output>/intermediate/``; trials to ``<output>/{IKData, IDData,
+EMGData, GRFData, MAData}``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import attrs
+
+from nmsm.errors import InputError
+from nmsm.io.storage import read_storage, table_from_columns, write_storage
+from nmsm.tools.preprocess import analyses
+from nmsm.tools.preprocess.emg import process_emg
+from nmsm.tools.preprocess.trials import TrialSources, split_into_trials
+from nmsm.tools.preprocess.velocity import create_velocity_file
+
+
+@attrs.frozen
+class EmgOptions:
+    """Raw-EMG processing (Hz; Butterworth order)."""
+
+    filter_order: int = 4
+    high_pass_cutoff: float = 40.0
+    low_pass_cutoff: float = 10.0
+
+
+@attrs.frozen
+class PreprocessRequest:
+    """What to preprocess. Paths may be None (the step is skipped or computed when possible)."""
+
+    time_pairs: tuple[tuple[float, float], ...]
+    output: Path
+    model: Path | None = None
+    prefix: str = "trial"
+    rows: int = 101
+    cutoff: float | None = 6.0
+    engine: str = "nmsm"
+    raw_emg: Path | None = None
+    processed_emg: Path | None = None
+    emg: EmgOptions = EmgOptions()
+    markers: Path | None = None
+    ik_settings: Path | None = None
+    ik: Path | None = None
+    inverse_dynamics: Path | None = None
+    external_loads: Path | None = None
+    grf: Path | None = None
+    muscle_analysis: Path | None = None
+    compute_muscle_analysis: bool = False
+    muscles: tuple[str, ...] = ()
+    coordinates: tuple[str, ...] = ()
+
+
+def process_raw_emg_file(raw: str | os.PathLike[str], output: str | os.PathLike[str], options: EmgOptions = EmgOptions()) -> Path:
+    """``processRawEmgFile``: filter, rectify, normalize every column of a raw EMG table."""
+    table = read_storage(raw)
+    processed = process_emg(table.time, table.data, filter_order=options.filter_order,
+                            high_pass_cutoff=options.high_pass_cutoff, low_pass_cutoff=options.low_pass_cutoff)
+    out = Path(output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return write_storage(out, table_from_columns(table.time, {l: processed[:, i] for i, l in enumerate(table.labels)},
+                                                 name="processedEmg"))
+
+
+def _rotational(model_file: Path | None) -> tuple[str, ...]:
+    if model_file is None:
+        return ()
+    from nmsm.model import load_model
+
+    model = load_model(model_file)
+    return tuple(c.name for c in model.coordinates if c.motion_type == "rotational")
+
+
+def preprocess(request: PreprocessRequest) -> list[str]:
+    """Run the steps of the module docstring; returns the trial names."""
+    out = Path(request.output)
+    work = out / "intermediate"
+    needs_model = request.markers is not None or request.compute_muscle_analysis or (
+        request.inverse_dynamics is None and request.external_loads is not None)
+    if needs_model and request.model is None:
+        raise InputError("a model is needed to compute IK, ID or muscle analysis", element="--model",
+                         expected="the subject's .osim model")
+    emg = request.processed_emg
+    if request.raw_emg is not None:
+        emg = process_raw_emg_file(request.raw_emg, work / "processedEmg.sto", request.emg)
+    ik = request.ik
+    if ik is None and request.markers is not None:
+        ik = analyses.inverse_kinematics(request.model, request.markers, work / "ik.mot", engine=request.engine,
+                                         ik_settings=request.ik_settings)
+    inverse_dynamics = request.inverse_dynamics
+    if inverse_dynamics is None and request.external_loads is not None:
+        if ik is None:
+            raise InputError("inverse dynamics needs a motion", element="--ik/--markers", expected="an IK file or markers")
+        inverse_dynamics = analyses.inverse_dynamics(request.model, ik, work / "id.sto", engine=request.engine,
+                                                     external_loads=request.external_loads, lowpass_hz=request.cutoff)
+    ma = request.muscle_analysis
+    if ma is None and request.compute_muscle_analysis:
+        if ik is None:
+            raise InputError("muscle analysis needs a motion", element="--ik/--markers", expected="an IK file or markers")
+        ma = analyses.muscle_analysis(request.model, ik, work / "MuscleAnalysis", engine=request.engine,
+                                      muscles=request.muscles or None, coordinates=request.coordinates or None,
+                                      name=request.prefix)
+    if ma is not None:
+        ma = Path(ma)
+        lengths = sorted(ma.glob("*_Length.sto"))
+        if lengths and not sorted(ma.glob("*_Velocity.sto")):
+            create_velocity_file(lengths[0])
+    sources = TrialSources(ik=ik, inverse_dynamics=inverse_dynamics, grf=request.grf, emg=emg,
+                           muscle_analysis=ma, rotational=_rotational(request.model) if ik is not None else ())
+    return split_into_trials(request.time_pairs, sources, out, prefix=request.prefix, rows=request.rows,
+                             cutoff=request.cutoff)
+
+
+def parse_time_pairs(texts: Sequence[str]) -> tuple[tuple[float, float], ...]:
+    """``["0.5 1.6", "2.1 3.2"]`` -> ``((0.5, 1.6), (2.1, 3.2))``."""
+    pairs = []
+    for text in texts:
+        parts = text.replace(",", " ").split()
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            raise InputError(f"time pair '{text}' is not two numbers", element="--time-pair",
+                             expected="'START END' in seconds") from None
+        if len(values) != 2:
+            raise InputError(f"time pair '{text}' has {len(values)} numbers", element="--time-pair",
+                             expected="'START END' in seconds")
+        pairs.append((values[0], values[1]))
+    return tuple(pairs)
+
+
+__all__ = ["EmgOptions", "PreprocessRequest", "parse_time_pairs", "preprocess", "process_raw_emg_file"]

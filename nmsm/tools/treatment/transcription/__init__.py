@@ -1,0 +1,1 @@
+"""Collocation schemes (Legendre-Gauss-Radau pseudospectral and Radau IIA meshes) for Treatment Optimization."""

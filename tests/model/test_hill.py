@@ -1,0 +1,114 @@
+"""Hill-type muscle model (:mod:`nmsm.model.hill`): curves, stability, CasADi = numpy, activation."""
+
+from __future__ import annotations
+
+import casadi as cs
+import numpy as np
+import pytest
+
+from nmsm.model import hill
+
+
+def _cs(f, *args):
+    syms = [cs.SX.sym(f"x{i}") for i in range(len(args))]
+    fun = cs.Function("f", syms, [f(*syms)])
+    return np.array([float(fun(*vals)) for vals in zip(*[np.atleast_1d(a) for a in args])])
+
+
+def test_curve_values_at_reference_points():
+    # optimal length gives ~1 active force, 0 velocity gives exactly 1
+    assert hill.active_force_length(1.0) == pytest.approx(1.0, abs=1e-3)
+    assert hill.force_velocity(0.0) == pytest.approx(1.0, abs=1e-12)
+    assert hill.force_velocity(-1.0) == pytest.approx(0.0, abs=5e-3)  # maximum shortening velocity
+    assert hill.force_velocity(1.0) > 1.3  # eccentric enhancement
+    e1, e2, e3 = hill.PASSIVE_FORCE_LENGTH_E
+    assert hill.passive_force_length(e3) == pytest.approx(e1 * np.log(2.0), rel=1e-14)
+
+
+def test_passive_softplus_is_stable():
+    l = np.array([-50.0, 0.0, 1.0, 2.0, 60.0, 1e3])
+    values = hill.passive_force_length(l)
+    assert np.all(np.isfinite(values))
+    e1, e2, e3 = hill.PASSIVE_FORCE_LENGTH_E
+    assert values[-1] == pytest.approx(e1 * e2 * (1e3 - e3), rel=1e-12)  # linear asymptote, no overflow
+    assert np.all(np.isfinite(_cs(hill.passive_force_length, l)))
+    # CasADi gradient finite too
+    x = cs.SX.sym("x")
+    grad = cs.Function("g", [x], [cs.gradient(hill.passive_force_length(x), x)])
+    assert float(grad(1e3)) == pytest.approx(e1 * e2, rel=1e-12)
+
+
+@pytest.mark.parametrize("func", [hill.active_force_length, hill.force_velocity, hill.passive_force_length])
+def test_casadi_matches_numpy(func):
+    x = np.linspace(-0.9, 1.8, 37)
+    assert np.allclose(_cs(func, x), func(x), rtol=1e-14, atol=1e-14)
+
+
+def test_forces_and_moments():
+    a, l, v = 0.3, 1.05, -0.1
+    f0, alpha = 2000.0, 0.2
+    total = hill.tendon_force(a, l, v, f0, alpha)
+    assert total == pytest.approx(hill.active_tendon_force(a, l, v, f0, alpha) + hill.passive_tendon_force(l, f0, alpha))
+    assert total == pytest.approx(
+        f0 * (a * hill.active_force_length(l) * hill.force_velocity(v) + hill.passive_force_length(l)) * np.cos(alpha))
+    arms = np.array([[[0.05, -0.02], [0.0, 0.03]]])  # (frames=1, coords=2, muscles=2)
+    forces = np.array([[100.0, 200.0]])
+    assert np.allclose(hill.joint_moments(arms, forces), [[0.05 * 100 - 0.02 * 200, 0.03 * 200]])
+
+
+def test_fiber_kinematics():
+    assert hill.normalized_fiber_length(0.35, 0.1, 0.25, 0.0) == pytest.approx(1.0)
+    assert hill.normalized_fiber_length(0.35, 0.1, 0.25, np.pi / 3) == pytest.approx(2.0)
+    assert hill.normalized_fiber_velocity(-1.0, 0.1, 0.0, 10.0) == pytest.approx(-1.0)
+
+
+def test_volume_roundtrip():
+    v = hill.muscle_volume(1500.0, 0.12, 610e3)
+    assert hill.max_isometric_force_from_volume(v, 0.12, 610e3) == pytest.approx(1500.0)
+    assert hill.max_isometric_force_from_volume(v, 0.24, 610e3) == pytest.approx(750.0)
+
+
+def test_neural_activation_step_response():
+    dt, tau = 0.001, 0.015
+    e = np.zeros(400)
+    e[50:] = 1.0
+    n = hill.neural_activation(e, tau, dt)
+    assert n[:50].max() == 0.0
+    # activation towards 1 with time constant tau (dn/dt = (e/tau)(1 - n) for e = 1)
+    k = 50 + int(round(tau / dt))
+    assert n[k] == pytest.approx(1 - np.exp(-1), abs=0.02)
+    assert n[-1] == pytest.approx(1.0, abs=1e-6)
+    # deactivation is 4x slower
+    e2 = np.ones(800)
+    e2[200:] = 0.0
+    m = hill.neural_activation(e2, tau, dt)
+    j = 200 + int(round(4 * tau / dt))
+    assert m[j] / m[199] == pytest.approx(np.exp(-1), abs=0.02)
+
+
+def test_neural_activation_casadi_matches_numpy():
+    rng = np.random.default_rng(0)
+    e = rng.random(60)
+    f = hill.neural_activation_function(60)
+    assert np.allclose(np.array(f(e, 0.02, 0.01)).ravel(), hill.neural_activation(e, 0.02, 0.01), atol=1e-15)
+    # vectorized numpy over muscles x frames
+    es = rng.random((3, 60))
+    taus = np.array([0.01, 0.02, 0.03])
+    assert np.allclose(hill.neural_activation(es, taus, 0.01)[1], hill.neural_activation(es[1], 0.02, 0.01))
+
+
+def test_activation_nonlinearity():
+    n = np.linspace(0, 1, 11)
+    assert np.allclose(hill.activation_nonlinearity(n, 0.0), n)
+    a = hill.activation_nonlinearity(n, 0.3)
+    assert a[-1] == pytest.approx(1.0, abs=1e-3)
+    assert np.all(np.diff(a) > 0)
+    assert np.allclose(_cs(lambda x: hill.activation_nonlinearity(x, 0.3), n), a, atol=1e-15)
+
+
+def test_clip_negative():
+    x = np.array([-1.0, 0.0, 2.0])
+    assert np.array_equal(hill.clip_negative(x), [0.0, 0.0, 2.0])
+    smooth = hill.clip_negative(x, 1e-4)
+    assert np.all(smooth >= hill.clip_negative(x))
+    assert np.all(smooth - hill.clip_negative(x) <= 0.5e-4 + 1e-15)

@@ -1,0 +1,117 @@
+"""Clear errors for bad GCP input: time grids, force-plate columns, foot markers, one-segment
+feet."""
+
+from __future__ import annotations
+
+import shutil
+import warnings
+
+import numpy as np
+import pytest
+
+from nmsm.errors import InputError, ModelError
+from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
+from nmsm.io.storage import read_storage, table_from_columns, write_storage
+from nmsm.tools.gcp.run import load_feet
+
+
+@pytest.fixture
+def case(synthetic_case, tmp_path):
+    folder = tmp_path / "case"
+    shutil.copytree(synthetic_case.folder, folder)
+    return folder
+
+
+def _load(folder, **replace):
+    text = (folder / "settings.xml").read_text()
+    for old, new in replace.items():
+        assert old in text
+        text = text.replace(old, new)
+    (folder / "settings.xml").write_text(text)
+    settings = GroundContactPersonalizationSettings.from_document(read_settings_document(folder / "settings.xml"))
+    return load_feet(settings)
+
+
+def _rewrite(path, time, table):
+    write_storage(path, table_from_columns(time, {k: np.interp(time, table.time, table.column(k))
+                                                  for k in table.labels}, name="x"))
+
+
+def test_grf_on_another_time_grid_is_resampled_with_a_warning(case):
+    grf = read_storage(case / "grf.sto")
+    _rewrite(case / "grf.sto", np.linspace(grf.time[0], grf.time[-1], 43), grf)  # 70 Hz: up to 7 ms off
+    with pytest.warns(UserWarning, match="linearly interpolated"):
+        feet, *_ = _load(case)
+    assert feet[0].n_frames == grf.n_rows
+    peak = grf.column("f1_vy").max()  # twice interpolated (101 -> 43 -> 61 samples): within 5 % of the peak
+    np.testing.assert_allclose(feet[0].reactions.forces[:, 1], grf.column("f1_vy"), atol=0.05 * peak)
+
+
+def test_grf_not_covering_the_window(case):
+    grf = read_storage(case / "grf.sto")
+    _rewrite(case / "grf.sto", grf.time[:40], grf)
+    with pytest.raises(InputError, match="ground reactions cover") as err:
+        _load(case)
+    assert "grf.sto" in str(err.value)
+
+
+def test_unevenly_sampled_motion(case):
+    motion = read_storage(case / "ik.sto")
+    time = motion.time.copy()
+    time[10:] += 0.004
+    write_storage(case / "ik.sto", table_from_columns(time, {k: motion.column(k) for k in motion.labels}, name="ik"))
+    with pytest.raises(InputError, match="not evenly spaced") as err:
+        _load(case)
+    assert "ik.sto" in str(err.value)
+
+
+def test_force_columns_not_in_the_file(case):
+    with pytest.raises(InputError, match="f1_vq") as err:
+        _load(case, **{"<force_columns>f1_vx f1_vy f1_vz": "<force_columns>f1_vx f1_vq f1_vz"})
+    message = str(err.value)
+    assert "settings.xml" in message and "<force_columns>" in message and "f1_vy" in message
+
+
+def test_wrong_number_of_columns(case):
+    with pytest.raises(InputError, match="3 columns"):
+        _load(case, **{"<moment_columns>m1_x m1_y m1_z": "<moment_columns>m1_x m1_y"})
+
+
+def test_foot_marker_missing_from_the_model(case):
+    with pytest.raises(InputError, match="no marker 'R_Hee'") as err:
+        _load(case, **{"<heel_marker>R_Heel": "<heel_marker>R_Hee"})
+    assert "<heel_marker>" in str(err.value)
+
+
+def test_model_without_a_two_segment_foot(case):
+    model = (case / "foot.osim").read_text()
+    model = model.replace('<PinJoint name="mtp_r">', '<WeldJoint name="mtp_r">').replace("</PinJoint>", "</WeldJoint>")
+    start, end = model.index("<WeldJoint"), model.index("</WeldJoint>")
+    block = model[start:end]
+    block = block[: block.index("<coordinates>")] + block[block.index("</coordinates>") + len("</coordinates>"):]
+    (case / "foot.osim").write_text(model[:start] + block + model[end:])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ModelError, match="two-segment foot") as err:
+            _load(case)
+    assert "foot.osim" in str(err.value) and "<hindfoot_body>" in str(err.value)
+
+
+def test_read_only_results_folder_fails_before_optimizing(case):
+    import os
+    import time
+
+    from nmsm.tools.gcp.run import run_settings
+
+    (case / "results").mkdir()
+    os.chmod(case / "results", 0o555)
+    try:
+        start = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with pytest.raises(InputError, match="read-only"):
+                run_settings(case / "settings.xml")
+        assert time.perf_counter() - start < 5.0
+    finally:
+        os.chmod(case / "results", 0o755)

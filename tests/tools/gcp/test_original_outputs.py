@@ -1,0 +1,59 @@
+"""nmsm's foot model, contact model and reaction transforms reproduce the MATLAB original's
+files of the tutorial (GCPResultsV1): experimental foot kinematics, the modeled ground
+reactions at its solution, and the replaced experimental reactions."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from nmsm.io.osimx import read_osimx
+from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
+from nmsm.io.storage import read_storage
+from nmsm.tools.gcp.compare import coefficients_from_kinematics, result_state
+from nmsm.tools.gcp.run import load_feet
+from nmsm.tools.gcp.values import as_array, foot_values
+
+
+@pytest.fixture(scope="module")
+def original_v1(tutorial):
+    folder = tutorial / "CompletedSettingsFiles"
+    results = folder / "GCPResultsV1"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        settings = GroundContactPersonalizationSettings.from_document(read_settings_document(folder / "GCPSettingsV1.xml"))
+        feet, *_ = load_feet(settings, spring_locations=results / "bodyModel_gcp.osimx")
+    kinematics = results / "bodyModel_Foot_1_optimizedFootKinematics.sto"
+    state = result_state(read_osimx(results / "bodyModel_gcp.osimx"), [kinematics], feet)
+    return feet[0], state, results
+
+
+def test_experimental_foot_kinematics(original_v1):
+    foot, _, results = original_v1
+    theirs = read_storage(results / "bodyModel_Foot_1_experimentalFootKinematics.sto")
+    assert theirs.labels[0] == foot.foot.toe_coordinate
+    np.testing.assert_allclose(foot.coordinates, theirs.data, atol=1e-9)
+
+
+def test_spline_nodes_and_kinematics_roundtrip(original_v1):
+    foot, _, results = original_v1
+    assert foot.n_nodes == 32  # the original's optimized kinematics lie exactly in this basis
+    theirs = read_storage(results / "bodyModel_Foot_1_optimizedFootKinematics.sto").data
+    _, error = coefficients_from_kinematics(foot, theirs)
+    assert error < 1e-12
+
+
+def test_modeled_and_replaced_reactions(original_v1):
+    foot, state, results = original_v1
+    values = foot_values(foot, state.design(), 0)
+    modeled = read_storage(results / "bodyModel_Foot_1_optimizedGroundReactions.sto")
+    replaced = read_storage(results / "bodyModel_Foot_1_replacedExperimentalGroundReactions.sto")
+    ours_f, ours_m = as_array(values.forces).T, as_array(values.moments).T
+    np.testing.assert_allclose(ours_f, modeled.columns(["Fx", "Fy", "Fz"]), atol=2e-3)
+    np.testing.assert_allclose(ours_m, modeled.columns(["Mx", "My", "Mz"]), atol=2e-3)
+    np.testing.assert_allclose(as_array(values.experimental_forces).T, replaced.columns(["Fx", "Fy", "Fz"]), atol=1e-9)
+    np.testing.assert_allclose(as_array(values.experimental_moments).T, replaced.columns(["Mx", "My", "Mz"]),
+                               atol=1e-6)

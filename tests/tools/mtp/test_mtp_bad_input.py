@@ -1,0 +1,118 @@
+"""Bad MTP input gives clear errors (file, element or column, expected), never NaN results."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from nmsm.errors import InputError
+from nmsm.io.storage import read_storage, table_from_columns, write_storage
+from nmsm.tools.mtp.run import prepare, run_settings
+
+TERMS = """
+<RCNLCostTerm><is_enabled>true</is_enabled><type>inverse_dynamics_joint_moment</type>
+  <max_allowable_error>2.5</max_allowable_error></RCNLCostTerm>
+<RCNLCostTerm><is_enabled>true</is_enabled><type>emg_scale_factor</type>
+  <max_allowable_error>0.2</max_allowable_error><error_center>0.3</error_center></RCNLCostTerm>"""
+
+
+def write_settings(folder: Path, tutorial: Path, *, channels: str = "GlutMaxLat RecFem BicFemLong BicFemShort VastMed GasMed Sol TibAnt",
+                   osimx: str = "") -> Path:
+    text = f"""<NMSMPipelineDocument Version="1.5.0"><MuscleTendonPersonalizationTool>
+ <results_directory>results</results_directory>
+ <input_model_file>{tutorial / 'UF_Subject_3_reduced_muscles.osim'}</input_model_file>
+ <input_osimx_file>{osimx}</input_osimx_file>
+ <data_directory>preprocessed</data_directory>
+ <coordinate_list>hip_flexion_r knee_angle_r ankle_angle_r</coordinate_list>
+ <activation_muscle_groups>HamslatActivationGroupR</activation_muscle_groups>
+ <normalized_fiber_length_muscle_groups/>
+ <missing_emg_channel_muscle_groups>HipFlexorsMissingEMGChannelGroup</missing_emg_channel_muscle_groups>
+ <collected_emg_channel_muscle_groups>{channels}</collected_emg_channel_muscle_groups>
+ <max_iterations>50</max_iterations>
+ <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
+ <MTPSynergyExtrapolation><is_enabled>false</is_enabled></MTPSynergyExtrapolation>
+ <MTPTaskList><MTPTask><is_enabled>true</is_enabled>
+  <muscle_specific_electromechanical_delays>true</muscle_specific_electromechanical_delays>
+  <RCNLCostTermSet>{TERMS}</RCNLCostTermSet></MTPTask></MTPTaskList>
+</MuscleTendonPersonalizationTool></NMSMPipelineDocument>"""
+    path = folder / "MTPSettings.xml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture
+def case(tmp_path, shared_data):
+    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
+    shutil.copytree(tutorial / "preprocessed", tmp_path / "preprocessed")
+    return tmp_path, tutorial
+
+
+def test_runs_clean(case):
+    folder, tutorial = case
+    outcome = run_settings(write_settings(folder, tutorial))
+    assert (folder / "results" / "UF_Subject_3_reduced_muscles_mtp.osimx").is_file()
+    assert np.isfinite(outcome.tasks[0].cost)
+
+
+def test_emg_channel_not_a_model_group(case):
+    folder, tutorial = case
+    settings = write_settings(folder, tutorial, channels="GlutMaxLat RecFem Bogus")
+    with pytest.raises(InputError) as info:
+        prepare(settings)
+    message = str(info.value)
+    assert "Bogus" in message and "collected_emg_channel_muscle_groups" in message and "GlutMaxLat" in message
+
+
+def test_emg_column_missing(case):
+    folder, tutorial = case
+    path = folder / "preprocessed" / "EMGData" / "gait_1.sto"
+    table = read_storage(path)
+    keep = [label for label in table.labels if label != "RecFem"]
+    write_storage(path, table.select(keep))
+    with pytest.raises(InputError) as info:
+        prepare(write_settings(folder, tutorial))
+    assert "RecFem" in str(info.value) and "gait_1.sto" in str(info.value)
+
+
+def test_trials_with_different_frame_counts(case):
+    folder, tutorial = case
+    data = folder / "preprocessed"
+    for sub in ("IDData", "EMGData", "IKData"):
+        table = read_storage(data / sub / "gait_1.sto")
+        cut = slice(0, table.n_rows - 2)
+        shortened = table_from_columns(table.time[cut], {l: table.column(l)[cut] for l in table.labels})
+        write_storage(data / sub / "gait_2.sto", shortened)
+    ma = data / "MAData"
+    shutil.copytree(ma / "gait_1", ma / "gait_2")
+    for f in (ma / "gait_2").iterdir():
+        table = read_storage(f)
+        cut = slice(0, table.n_rows - 2)
+        write_storage(f.with_name(f.name.replace("gait_1", "gait_2")),
+                      table_from_columns(table.time[cut], {l: table.column(l)[cut] for l in table.labels}))
+        f.unlink()
+    with pytest.raises(InputError, match="different frame counts"):
+        prepare(write_settings(folder, tutorial))
+
+
+def test_missing_moment_arm_file(case):
+    folder, tutorial = case
+    (folder / "preprocessed" / "MAData" / "gait_1" / "gait_1_MomentArm_knee_angle_r.sto").unlink()
+    with pytest.raises(InputError) as info:
+        prepare(write_settings(folder, tutorial))
+    assert "knee_angle_r" in str(info.value) and "moment-arm" in str(info.value)
+
+
+def test_zero_tendon_slack_length_is_rejected(case):
+    folder, tutorial = case
+    osimx = folder / "bad.osimx"
+    osimx.write_text("""<NMSMPipelineDocument Version="1.5.3"><OsimxModel name="m">
+ <associated_osim_model>m.osim</associated_osim_model><RCNLMuscleSet>
+ <RCNLMuscle name="soleus_r"><tendon_slack_length>0</tendon_slack_length></RCNLMuscle>
+ </RCNLMuscleSet></OsimxModel></NMSMPipelineDocument>""")
+    with pytest.raises(InputError) as info:
+        prepare(write_settings(folder, tutorial, osimx=str(osimx)))
+    assert "tendon_slack_length" in str(info.value) and "soleus_r" in str(info.value)
