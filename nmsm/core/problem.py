@@ -179,10 +179,10 @@ class OptimizationProblem:
         if scale is None:
             finite = np.isfinite(lo) & np.isfinite(hi) & (hi > lo)
             sc = np.ones(shape)
-            sc[finite] = (hi - lo)[finite]
+            sc[finite] = hi[finite] - lo[finite]
             if offset is None:
                 off = np.zeros(shape)
-                off[finite] = 0.5 * (hi + lo)[finite]
+                off[finite] = 0.5 * (hi[finite] + lo[finite])
             else:
                 off = _as_array(offset, shape, "offset", name)
         else:
