@@ -15,6 +15,7 @@ the personalization tools' trials (tools.md §2).
       <cutoff_frequency>6</cutoff_frequency>
       <emg_high_pass_frequency>40</emg_high_pass_frequency>
       <emg_low_pass_frequency>10</emg_low_pass_frequency>
+      <emg_demean>channel</emg_demean>                 <!-- or frame: the original's -->
     </DataPreprocessingTool></NMSMPipelineDocument>
 """
 
@@ -68,5 +69,8 @@ class DataPreprocessingSettings:
                                              doc="EMG high-pass cutoff (Hz)")
     emg_low_pass_frequency: float = setting("emg_low_pass_frequency", kind="number", default=10.0, check=positive,
                                             doc="EMG envelope low-pass cutoff (Hz)")
+    emg_demean: str = setting("emg_demean", kind="text", default="channel", choices=("channel", "frame"),
+                              doc="EMG mean and minimum per channel over time (channel), or across channels "
+                                  "at each frame as the original computes them (frame)")
     emg_padding_time: float = setting("emg_padding_time", kind="number", default=0.2, check=positive,
                                       doc="EMG kept before and after each trial (s), for the electromechanical delay")

@@ -34,7 +34,8 @@ def _check(engine: str) -> None:
 def inverse_kinematics(model_file: str | os.PathLike[str], marker_file: str | os.PathLike[str],
                        output: str | os.PathLike[str], *, engine: str = "nmsm",
                        ik_settings: str | os.PathLike[str] | None = None) -> Path:
-    """Coordinates over the marker trial written to ``output`` (.mot)."""
+    """Coordinates over the marker trial written to ``output`` (.mot); ``ik_settings`` (an
+    OpenSim IK setup file) gives marker weights, time range and accuracy to either engine."""
     _check(engine)
     out = Path(output)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -44,9 +45,14 @@ def inverse_kinematics(model_file: str | os.PathLike[str], marker_file: str | os
         run_ik_files(model_file, marker_file, ik_settings=ik_settings, output=out)
     else:
         from nmsm.opensim_bridge import get_bridge
+        from nmsm.tools.jmp.ik_settings import read_ik_settings
 
+        settings = read_ik_settings(ik_settings) if ik_settings is not None else None
+        options = {} if settings is None else {
+            "marker_weights": settings.marker_weights, "time_range": settings.time_range,
+            **({"accuracy": settings.accuracy} if settings.accuracy is not None else {})}
         get_bridge().call("opensim_inverse_kinematics_tool", model=str(Path(model_file).resolve()),
-                          marker_file=str(Path(marker_file).resolve()), output_motion=str(out.resolve()))
+                          marker_file=str(Path(marker_file).resolve()), output_motion=str(out.resolve()), **options)
     return out
 
 

@@ -3,7 +3,7 @@
 Example (the tutorial's step 2)::
 
     nmsm preprocess --model UF_Subject_3.osim --time-pair "0.5 1.6" --prefix gait \\
-        --raw-emg input_data/GaitTrial48_EMG.mot --ik GaitTrial48_IKResults.mot \\
+        --raw-emg input_data/GaitTrial48_EMG.mot --emg-low-pass 3.1818 --ik GaitTrial48_IKResults.mot \\
         --id GaitTrial48_ID.sto --grf GaitTrial48_forces.mot --muscle-analysis MuscleAnalysis \\
         --output preprocessed
 
@@ -36,7 +36,9 @@ def _preprocess(args: argparse.Namespace) -> int:
         engine=args.engine,
         raw_emg=_path(args.raw_emg),
         processed_emg=_path(args.emg),
-        emg=EmgOptions(args.emg_order, args.emg_high_pass, args.emg_low_pass),
+        emg=EmgOptions(args.emg_order, args.emg_high_pass, args.emg_low_pass, args.emg_demean),
+        emg_channels=tuple(args.emg_channels.split()) if args.emg_channels else (),
+        emg_padding_time=args.emg_padding_time,
         markers=_path(args.markers),
         ik_settings=_path(args.ik_settings),
         ik=_path(args.ik),
@@ -69,7 +71,14 @@ def register(subparsers: Any) -> None:
     p.add_argument("--emg", help="already processed EMG table")
     p.add_argument("--emg-order", type=int, default=4, help="Butterworth order of the EMG filters")
     p.add_argument("--emg-high-pass", type=float, default=40.0, help="EMG high-pass cut-off (Hz)")
-    p.add_argument("--emg-low-pass", type=float, default=10.0, help="EMG low-pass (envelope) cut-off (Hz)")
+    p.add_argument("--emg-low-pass", type=float, default=10.0,
+                   help="EMG low-pass (envelope) cut-off (Hz); the tutorial uses 3.5/1.1 = 3.1818")
+    p.add_argument("--emg-demean", choices=["frame", "channel"], default="frame",
+                   help="frame: the original's mean/min across channels at each frame (default); "
+                        "channel: each channel's own mean/min")
+    p.add_argument("--emg-channels", help="space-separated EMG columns to keep (default all); each must exist")
+    p.add_argument("--emg-padding-time", type=float, default=0.2,
+                   help="EMG kept before and after each trial (s), for the electromechanical delay")
     p.add_argument("--markers", help="marker file (.trc): compute IK")
     p.add_argument("--ik-settings", help="IK settings XML (marker weights, accuracy) for --markers")
     p.add_argument("--ik", help="IK motion (.mot)")

@@ -5,7 +5,8 @@ Steps (tools.md §2), each optional:
 1. raw EMG -> processed EMG (:func:`nmsm.tools.preprocess.emg.process_emg`);
 2. IK from markers, ID from IK (+ external loads), muscle analysis from IK, through nmsm's
    model core or OpenSim (``engine``), unless the files are given;
-3. muscle-tendon velocity from lengths when the analysis folder has none;
+3. muscle-tendon velocity from lengths when the analysis folder has none (made in a copy
+   of the folder under ``intermediate/``: inputs are never written);
 4. split everything into trials (:func:`nmsm.tools.preprocess.trials.split_into_trials`).
 
 Intermediate files go to ``<output>/intermediate/``; trials to ``<output>/{IKData, IDData,
@@ -15,31 +16,42 @@ EMGData, GRFData, MAData}``.
 from __future__ import annotations
 
 import os
+import shutil
 from collections.abc import Sequence
 from pathlib import Path
 
 import attrs
 
 from nmsm.errors import InputError
-from nmsm.io.storage import read_storage, table_from_columns, write_storage
+from nmsm.io.storage import Table, write_storage
 from nmsm.tools.preprocess import analyses
 from nmsm.tools.preprocess.emg import process_emg
-from nmsm.tools.preprocess.trials import TrialSources, split_into_trials
+from nmsm.tools.preprocess.tables import read_table
+from nmsm.tools.preprocess.trials import EMG_PADDING_SECONDS, TrialSources, split_into_trials
 from nmsm.tools.preprocess.velocity import create_velocity_file
 
 
 @attrs.frozen
 class EmgOptions:
-    """Raw-EMG processing (Hz; Butterworth order)."""
+    """Raw-EMG processing: Butterworth order, cut-offs (Hz), demean mode (:mod:`.emg`).
+
+    The original's defaults are 40 Hz and 10 Hz; its tutorial runs ``low_pass_cutoff =
+    3.5 / 1.1`` (3.5 cycles over the 1.1 s gait trial).
+    """
 
     filter_order: int = 4
     high_pass_cutoff: float = 40.0
     low_pass_cutoff: float = 10.0
+    demean: str = "frame"
 
 
 @attrs.frozen
 class PreprocessRequest:
-    """What to preprocess. Paths may be None (the step is skipped or computed when possible)."""
+    """What to preprocess. Paths may be None (the step is skipped or computed when possible).
+
+    ``emg_channels``: the EMG columns to keep (e.g. the model's muscle-group names); each must
+    exist in the EMG file. Empty: all columns.
+    """
 
     time_pairs: tuple[tuple[float, float], ...]
     output: Path
@@ -51,6 +63,8 @@ class PreprocessRequest:
     raw_emg: Path | None = None
     processed_emg: Path | None = None
     emg: EmgOptions = EmgOptions()
+    emg_channels: tuple[str, ...] = ()
+    emg_padding_time: float = EMG_PADDING_SECONDS
     markers: Path | None = None
     ik_settings: Path | None = None
     ik: Path | None = None
@@ -63,15 +77,32 @@ class PreprocessRequest:
     coordinates: tuple[str, ...] = ()
 
 
-def process_raw_emg_file(raw: str | os.PathLike[str], output: str | os.PathLike[str], options: EmgOptions = EmgOptions()) -> Path:
-    """``processRawEmgFile``: filter, rectify, normalize every column of a raw EMG table."""
-    table = read_storage(raw)
+def process_emg_table(table: Table, options: EmgOptions = EmgOptions()) -> Table:
+    """``processEmg`` on every column of a raw EMG table: the processed table (same times)."""
     processed = process_emg(table.time, table.data, filter_order=options.filter_order,
-                            high_pass_cutoff=options.high_pass_cutoff, low_pass_cutoff=options.low_pass_cutoff)
+                            high_pass_cutoff=options.high_pass_cutoff, low_pass_cutoff=options.low_pass_cutoff,
+                            demean=options.demean, labels=table.labels)
+    return Table(time=table.time, labels=table.labels, data=processed, name="processedEmg", source=table.source)
+
+
+def select_channels(table: Table, channels: Sequence[str]) -> Table:
+    """The EMG columns ``channels`` (in that order); a missing one is an error naming it."""
+    if not channels:
+        return table
+    missing = [c for c in channels if c not in table.labels]
+    if missing:
+        raise InputError(f"EMG column(s) {', '.join(missing)} not in the EMG file", file=table.source,
+                         element="EMG columns", expected=f"one of {', '.join(table.labels)}")
+    return attrs.evolve(table, labels=tuple(channels), data=table.columns(list(channels)))
+
+
+def process_raw_emg_file(raw: str | os.PathLike[str], output: str | os.PathLike[str],
+                         options: EmgOptions = EmgOptions(), channels: Sequence[str] = ()) -> Path:
+    """``processRawEmgFile``: filter, rectify, normalize every column (or ``channels``) of a raw EMG file."""
+    table = select_channels(read_table(raw), channels)
     out = Path(output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    return write_storage(out, table_from_columns(table.time, {l: processed[:, i] for i, l in enumerate(table.labels)},
-                                                 name="processedEmg"))
+    return write_storage(out, process_emg_table(table, options))
 
 
 def _rotational(model_file: Path | None) -> tuple[str, ...]:
@@ -81,6 +112,21 @@ def _rotational(model_file: Path | None) -> tuple[str, ...]:
 
     model = load_model(model_file)
     return tuple(c.name for c in model.coordinates if c.motion_type == "rotational")
+
+
+def _with_velocity(folder: Path, work: Path) -> Path:
+    """A muscle-analysis folder with a ``*_Velocity.sto``: ``folder`` itself, or a copy in
+    ``work`` with the velocity made from the lengths (the user's folder is not written)."""
+    lengths = sorted(folder.glob("*_Length.sto"))
+    if not lengths or sorted(folder.glob("*_Velocity.sto")):
+        return folder
+    if folder.resolve() != work.resolve():
+        work.mkdir(parents=True, exist_ok=True)
+        for path in folder.iterdir():
+            if path.is_file() and path.suffix.lower() in (".sto", ".mot"):
+                shutil.copyfile(path, work / path.name)
+    create_velocity_file(work / lengths[0].name)
+    return work
 
 
 def preprocess(request: PreprocessRequest) -> list[str]:
@@ -94,7 +140,9 @@ def preprocess(request: PreprocessRequest) -> list[str]:
                          expected="the subject's .osim model")
     emg = request.processed_emg
     if request.raw_emg is not None:
-        emg = process_raw_emg_file(request.raw_emg, work / "processedEmg.sto", request.emg)
+        emg = process_raw_emg_file(request.raw_emg, work / "processedEmg.sto", request.emg, request.emg_channels)
+    elif emg is not None and request.emg_channels:
+        emg = select_channels(read_table(emg), request.emg_channels)
     ik = request.ik
     if ik is None and request.markers is not None:
         ik = analyses.inverse_kinematics(request.model, request.markers, work / "ik.mot", engine=request.engine,
@@ -113,14 +161,11 @@ def preprocess(request: PreprocessRequest) -> list[str]:
                                       muscles=request.muscles or None, coordinates=request.coordinates or None,
                                       name=request.prefix)
     if ma is not None:
-        ma = Path(ma)
-        lengths = sorted(ma.glob("*_Length.sto"))
-        if lengths and not sorted(ma.glob("*_Velocity.sto")):
-            create_velocity_file(lengths[0])
+        ma = _with_velocity(Path(ma), work / "MuscleAnalysis")
     sources = TrialSources(ik=ik, inverse_dynamics=inverse_dynamics, grf=request.grf, emg=emg,
                            muscle_analysis=ma, rotational=_rotational(request.model) if ik is not None else ())
     return split_into_trials(request.time_pairs, sources, out, prefix=request.prefix, rows=request.rows,
-                             cutoff=request.cutoff)
+                             cutoff=request.cutoff, emg_padding_time=request.emg_padding_time)
 
 
 def parse_time_pairs(texts: Sequence[str]) -> tuple[tuple[float, float], ...]:
@@ -140,4 +185,5 @@ def parse_time_pairs(texts: Sequence[str]) -> tuple[tuple[float, float], ...]:
     return tuple(pairs)
 
 
-__all__ = ["EmgOptions", "PreprocessRequest", "parse_time_pairs", "preprocess", "process_raw_emg_file"]
+__all__ = ["EmgOptions", "PreprocessRequest", "parse_time_pairs", "preprocess", "process_emg_table",
+           "process_raw_emg_file", "select_channels"]

@@ -1,7 +1,9 @@
 """Low-pass filtering and resampling of data tables (the original's ``lowpassFilter`` and GCV splines).
 
-* :func:`lowpass`: Butterworth (order 4 unless given) with MATLAB ``filtfilt`` on each
-  de-meaned column, mean added back (cut-off in Hz, time in s).
+* :func:`lowpass`: the original's ``lowpassFilter``: Butterworth (order 4 unless given)
+  with MATLAB ``filtfilt`` on each de-meaned column, mean added back (cut-off in Hz, time in
+  s); sampling rate ``1 / (t(2) - t(1))`` as ``lowpassFilter`` takes it (the EMG chain
+  uses ``n / (t_end - t_0)`` instead, :func:`~nmsm.tools.preprocess.emg.sampling_rate`).
 * :func:`resample`: OpenSim ``GCVSplineSet`` of degree 5 with zero error variance = the
   natural quintic interpolating spline (:func:`nmsm.model.signal.quintic_spline`),
   evaluated at new times; times outside the data are an error (the original gets NaN).
@@ -15,13 +17,20 @@ from scipy.signal import butter
 from nmsm.errors import InputError
 from nmsm.io.storage import Table
 from nmsm.model.signal import quintic_spline
-from nmsm.tools.preprocess.emg import matlab_filtfilt, sampling_rate
+from nmsm.tools.preprocess.emg import matlab_filtfilt
 
 
 def lowpass(time: np.ndarray, data: np.ndarray, cutoff: float, order: int = 4) -> np.ndarray:
     """Zero-phase Butterworth low-pass of each column of ``data`` (n, k) at ``cutoff`` Hz."""
     x = np.asarray(data, dtype=float)
-    fs = sampling_rate(time)
+    t = np.asarray(time, dtype=float)
+    if t.size < 2 or not t[1] > t[0]:
+        raise InputError("time does not increase", element="time", expected="increasing sample times")
+    fs = 1.0 / (t[1] - t[0])
+    steps = np.diff(t)
+    if np.abs(steps - steps[0]).max() > 0.01 * steps[0]:
+        raise InputError(f"samples are unevenly spaced ({steps.min():g}-{steps.max():g} s)", element="time",
+                         expected="evenly sampled data to low-pass filter")
     if not 0 < cutoff < fs / 2:
         raise InputError(f"low-pass cut-off {cutoff} Hz", element="cutoff frequency",
                          expected=f"between 0 and {fs / 2:g} Hz (Nyquist)")
@@ -43,3 +52,27 @@ def resample(table: Table, times: np.ndarray, *, what: str = "table") -> np.ndar
         )
     values, _, _ = quintic_spline(table.time, table.data, np.clip(t, lo, hi))
     return values
+
+
+def resample_with_gaps(time: np.ndarray, data: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Linear interpolation of ``data`` (n, k) at ``times`` (m,) keeping NaN gaps (m, k).
+
+    For ground-reaction centre-of-pressure columns, NaN while the foot is off the plate: a
+    time next to a gap takes the valid neighbour's value, a time between two NaN samples
+    stays NaN, so the swing phase never mixes into the stance values.
+    """
+    out = np.empty((times.size, data.shape[1]))
+    right = np.clip(np.searchsorted(time, times), 0, time.size - 1)
+    left = np.clip(right - 1, 0, time.size - 1)
+    for j in range(data.shape[1]):
+        column = data[:, j]
+        valid = ~np.isnan(column)
+        if valid.all():
+            out[:, j] = np.interp(times, time, column)
+            continue
+        if not valid.any():
+            out[:, j] = np.nan
+            continue
+        out[:, j] = np.interp(times, time[valid], column[valid])
+        out[~valid[left] & ~valid[right], j] = np.nan
+    return out
