@@ -127,6 +127,13 @@ class Pendulum:
         p = cs.SX.zeros(3) if i == 0 else self._joint_points(q[: self.n])[i - 1]
         return cs.Function(f"origin_{body}", [q], [p])
 
+    def mass_properties(self, body: str) -> tuple[float, np.ndarray, np.ndarray]:
+        """(mass kg, centre of mass (3,) m and inertia about it (3, 3) kg·m², body frame): a
+        uniform rod along the body's -y axis (whole-body quantities of Design Optimization)."""
+        self.body_names.index(body)
+        rod = self.mass * self.length**2 / 12.0
+        return self.mass, np.array([0.0, -0.5 * self.length, 0.0]), np.diag([rod, 0.0, rod])
+
     # ---- synthetic data ----------------------------------------------------------------------
     def motion(self, times: np.ndarray, amplitude: float = 0.6, frequency: float = 1.0) -> np.ndarray:
         """A smooth test motion (n_frames, n) of the independent coordinates (rad)."""
