@@ -1,15 +1,25 @@
 """Individual muscle activation controller (``<RCNLMuscleController>``): one control per muscle.
 
-Each muscle's activation (0..1) is a control ``<muscle>``; forces and moments come from the
-surrogate geometry and the Hill model as for the synergy controller
-(:mod:`nmsm.tools.treatment.muscles`). Used for comparisons with OpenSim Moco
-(muscle-driven tracking). Settings: ``muscle_list`` (muscles of the model, default: every
-muscle of the surrogate), the surrogate elements of the synergy controller
-(``surrogate_model_coordinate_list``, ``surrogate_model_data_directory``,
-``surrogate_model_polynomial_degree``, ``epsilon``, ``load_surrogate_model``,
-``save_surrogate_model``), ``maximum_shortening_velocity_multiplier``, and
-``minimum_activation`` [0.01] (lower bound). Initial guess and ``controller_tracking``
-reference: ``<trial>_combinedActivations.sto`` when present, else 0.1.
+Each muscle's activation (0..1) is a control ``<muscle>`` (no activation dynamics: the
+activation is the control). Used for comparisons with OpenSim Moco (muscle-driven tracking).
+
+Settings: ``muscle_list`` (default: every muscle of the geometry), ``surrogate_model_coordinate_list``
+(the coordinates that receive muscle moments), ``minimum_activation`` [0.01] (lower bound),
+``maximum_shortening_velocity_multiplier`` [10 l_o/s], and
+
+* **geometry**: with ``surrogate_model_data_directory`` the surrogate of the synergy
+  controller (``surrogate_model_polynomial_degree``, ``epsilon``, ``load_surrogate_model``,
+  ``save_surrogate_model``); without it the **exact path geometry** of the ``.osim``
+  (:class:`nmsm.model.muscle_paths.PathMuscleGeometry`: path-point muscles without
+  wrapping, e.g. the Moco 2D gait model); other coordinates are held at 0 in it, so the
+  coordinate list must contain every coordinate the muscles span;
+* **force model** ``muscle_force_model``: ``nmsm`` (default, the pipeline's rigid-tendon
+  Hill model, :mod:`nmsm.model.hill`) or ``degroote2016`` (OpenSim's
+  DeGrooteFregly2016Muscle with ``ignore_tendon_compliance``: De Groote et al. 2016
+  curves, fixed-width pennation, fiber damping; :func:`degroote_tendon_force`).
+
+Initial guess and ``controller_tracking`` reference: ``<trial>_combinedActivations.sto``
+when present, else 0.1.
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
+import attrs
 import casadi as cs
 import numpy as np
 
@@ -26,6 +37,92 @@ from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
 
 PREFIX = "activation:"
 DEFAULT_GUESS = 0.1
+FORCE_MODELS = ("nmsm", "degroote2016")
+
+#: DeGrooteFregly2016Muscle active force-length Gaussians (amplitude, centre, width b3 + b4 l)
+DGF_ACTIVE = ((0.8150671134243542, 1.055033428970575, 0.162384573599574, 0.063303448465465),
+              (0.433004984392647, 0.716775413397760, -0.029947116970696, 0.200356847296188),
+              (0.1, 1.0, 0.353553390593274, 0.0))
+#: force-velocity d1..d4: f_V = d1 log(d2 v + d3 + sqrt((d2 v + d3)^2 + 1)) + d4
+DGF_VELOCITY = (-0.3211346127989808, -8.149, -0.374, 0.8825327733249912)
+#: passive curve: k_PE, strain at one normalized force e0, minimum normalized fiber length
+DGF_PASSIVE = (4.0, 0.6, 0.2)
+
+
+def degroote_tendon_force(a: Any, length: Any, velocity: Any, F0: Any, lo: Any, lts: Any, alpha_opt: Any,
+                          vmax: float, damping: Any) -> tuple[Any, Any, Any]:
+    """Rigid-tendon DeGrooteFregly2016Muscle (OpenSim 4.x, ``ignore_tendon_compliance``):
+    fiber length ``l_M = sqrt((L - l_ts)^2 + (l_o sin α_o)^2)``, ``cos α = (L - l_ts)/l_M``,
+    fiber velocity ``V cos α``; ``F = F0 (a f_L f_V + f_P + damping ṽ) cos α`` (N).
+    Returns (F, l̃ = l_M/l_o, ṽ = v_M/(vmax l_o)). Works on SX/MX/DM (elementwise)."""
+    along = length - lts
+    height = lo * cs.sin(alpha_opt)
+    fiber = cs.sqrt(along**2 + height**2)
+    cos_alpha = along / fiber
+    l_norm = fiber / lo
+    v_norm = velocity * cos_alpha / (vmax * lo)
+    f_l = 0
+    for b1, b2, b3, b4 in DGF_ACTIVE:
+        f_l = f_l + b1 * cs.exp(-0.5 * (l_norm - b2) ** 2 / (b3 + b4 * l_norm) ** 2)
+    d1, d2, d3, d4 = DGF_VELOCITY
+    x = d2 * v_norm + d3
+    f_v = d1 * cs.log(x + cs.sqrt(x**2 + 1)) + d4
+    k, e0, lmin = DGF_PASSIVE
+    offset = np.exp(k * (lmin - 1) / e0)
+    f_p = (cs.exp(k * (l_norm - 1) / e0) - offset) / (np.exp(k) - offset)
+    force = F0 * (a * f_l * f_v + f_p + damping * v_norm) * cos_alpha
+    return force, l_norm, v_norm
+
+
+class PathGeometry:
+    """Exact path-point geometry with the interface of a surrogate (``muscle_names``,
+    ``function(coordinates, muscles)``): ``(q_c, qd_c) -> (lengths (M,), velocities (M,),
+    moment arms (M, n_c))`` with the model's other coordinates at 0."""
+
+    def __init__(self, model: Any, coordinates: Sequence[str], muscles: Sequence[str] | None = None) -> None:
+        from nmsm.model.muscle_paths import PathMuscleGeometry
+
+        self.model = model
+        self.coordinates = tuple(coordinates)
+        self.geometry = PathMuscleGeometry(model, muscles=muscles, coordinates=self.coordinates)
+        self.muscle_names = self.geometry.muscles
+
+    def function(self, coordinates: Sequence[str] | None = None, muscles: Sequence[str] | None = None,
+                 name: str = "path_muscle_geometry") -> cs.Function:
+        coords = tuple(coordinates or self.coordinates)
+        chosen = list(muscles or self.muscle_names)
+        full = self.geometry.function()
+        n_q = len(self.model.coordinates)
+        q, qd = cs.SX.sym("q", len(coords)), cs.SX.sym("qd", len(coords))
+        q_full, qd_full = cs.SX.zeros(n_q, 1), cs.SX.zeros(n_q, 1)
+        for j, c in enumerate(coords):
+            q_full[self.model.coordinate_index(c)] = q[j]
+            qd_full[self.model.coordinate_index(c)] = qd[j]
+        lengths, velocities, arms = full(q_full, qd_full)
+        rows = [self.muscle_names.index(m) for m in chosen]
+        columns = [self.geometry.coordinates.index(c) for c in coords]
+        return cs.Function(name, [q, qd], [lengths[rows], velocities[rows], arms[rows, columns]])
+
+
+@attrs.define
+class DeGrooteMuscleModel(MuscleModel):
+    """:class:`MuscleModel` with the DeGrooteFregly2016 rigid-tendon force model."""
+
+    damping: np.ndarray = attrs.field(factory=lambda: np.zeros(0))
+
+    def point_function(self) -> cs.Function:
+        if self._function is None:
+            geometry = self.surrogate.function(self.coordinates, self.muscles)
+            nc, M = len(self.coordinates), self.n
+            q, qd, a = cs.SX.sym("q", nc), cs.SX.sym("qd", nc), cs.SX.sym("a", M)
+            p = cs.SX.sym("p", 3 * M)
+            F0, lo, lts = p[:M], p[M:2 * M], p[2 * M:]
+            lengths, velocities, arms = geometry(q, qd)
+            forces, l_norm, v_norm = degroote_tendon_force(a, lengths, velocities, F0, lo, lts, cs.DM(self.pennation),
+                                                           self.vmax_factor, cs.DM(self.damping))
+            moments = cs.mtimes(arms.T, forces)
+            self._function = cs.Function("muscle_forces", [q, qd, a, p], [forces, moments, l_norm, v_norm])
+        return self._function
 
 
 class MuscleActivationController(Controller):
@@ -42,12 +139,27 @@ class MuscleActivationController(Controller):
         if not coordinates:
             raise setup.error("the muscle controller needs <surrogate_model_coordinate_list>",
                               element="<RCNLMuscleController>")
-        surrogate = load_surrogate(
-            setup.model_file, setting(settings, "surrogate_model_data_directory"), coordinates,
-            degree=int(setting(settings, "surrogate_model_polynomial_degree", 5)),
-            epsilon=float(setting(settings, "epsilon", 1e-4)), load=bool(setting(settings, "load_surrogate_model", False)),
-            save=bool(setting(settings, "save_surrogate_model", False)), settings_file=setup.settings_file)
-        muscles = name_list(setting(settings, "muscle_list")) or surrogate.muscle_names
+        force_model = str(setting(settings, "muscle_force_model", "nmsm")).lower()
+        if force_model not in FORCE_MODELS:
+            raise setup.error(f"unknown muscle force model '{force_model}'", element="<muscle_force_model>",
+                              expected=" or ".join(FORCE_MODELS))
+        model = load_model(setup.model_file)
+        muscles = name_list(setting(settings, "muscle_list"))
+        data_directory = setting(settings, "surrogate_model_data_directory")
+        if data_directory is None:
+            try:
+                surrogate: Any = PathGeometry(model, coordinates, muscles or None)
+            except Exception as exc:  # ModelError: wrapping muscles or bad coordinates
+                raise setup.error(f"no exact muscle geometry: {exc}", element="<RCNLMuscleController>",
+                                  expected="path-point muscles, or a <surrogate_model_data_directory>") from exc
+        else:
+            surrogate = load_surrogate(
+                setup.model_file, data_directory, coordinates,
+                degree=int(setting(settings, "surrogate_model_polynomial_degree", 5)),
+                epsilon=float(setting(settings, "epsilon", 1e-4)),
+                load=bool(setting(settings, "load_surrogate_model", False)),
+                save=bool(setting(settings, "save_surrogate_model", False)), settings_file=setup.settings_file)
+        muscles = muscles or surrogate.muscle_names
         osimx = None
         if setup.osimx is not None:
             from nmsm.io.osimx import read_osimx
@@ -56,9 +168,15 @@ class MuscleActivationController(Controller):
         self.coordinates = coordinates
         self.muscles = tuple(muscles)
         self.minimum = float(setting(settings, "minimum_activation", 0.01))
+        self.force_model = force_model
         self.muscle_model = MuscleModel.build(
-            self.muscles, coordinates, surrogate, load_model(setup.model_file), osimx,
+            self.muscles, coordinates, surrogate, model, osimx,
             float(setting(settings, "maximum_shortening_velocity_multiplier", 10.0)), where=setup.settings_file)
+        if force_model == "degroote2016":
+            base = self.muscle_model
+            damping = np.array([float(model.muscle(m).properties.get("fiber_damping", 0.0)) for m in self.muscles])
+            self.muscle_model = DeGrooteMuscleModel(base.muscles, base.coordinates, base.surrogate, base.parameters,
+                                                    base.pennation, base.vmax_factor, damping=damping)
 
     @classmethod
     def from_settings(cls, settings: Any, setup: ControllerSetup) -> MuscleActivationController:

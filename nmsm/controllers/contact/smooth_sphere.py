@@ -1,34 +1,77 @@
-"""OpenSim's SmoothSphereHalfSpaceForce elements of the model as a contact model.
+"""OpenSim's SmoothSphereHalfSpaceForce elements of the model as contact models.
 
-One instance per force-applying ``SmoothSphereHalfSpaceForce`` of the ``.osim`` (e.g. the
-2D gait model of the Moco example). The force acts on the sphere's body at the contact
-point; the ground reaction columns are ``<name>_force_vx|vy|vz``, ``<name>_torque_x|y|z``
-(about the ground origin) and ``<name>_force_px|py|pz`` (contact point). Formulas:
+Formulas (as Simbody/OpenSim compute them, checked against OpenSim through the bridge in
+``tests/model/test_contact.py`` and ``tests/tools/treatment/test_moco2d.py``):
 :mod:`nmsm.model.contact_smooth_sphere`.
+
+Two layouts, chosen by :meth:`SmoothSphereContact.discover`:
+
+* **per foot** (OpenSim's gait convention, as ``createExternalLoadsTableForGait`` and
+  Moco's ``MocoContactTrackingGoal`` groups use it): when the tracked ground reactions
+  (``GRFData/<trial>.sto``) have the columns ``ground_force_r_vx`` / ``ground_force_l_vx``,
+  the force elements whose names end in ``_r`` (``_l``) are summed into one contact model
+  ``ground_force_r`` (``ground_force_l``) with columns ``ground_force_<s>_vx|vy|vz``,
+  ``ground_torque_<s>_x|y|z`` (about the ground origin) and ``ground_force_<s>_px|py|pz``
+  (the normal-force weighted mean of the contact points). The Moco 2D gait reference
+  ``referenceGRF.sto`` has these columns.
+* **per element** otherwise: one model per force-applying element, columns
+  ``<name>_force_vx|vy|vz``, ``<name>_torque_x|y|z`` (about the ground origin) and
+  ``<name>_force_px|py|pz`` (contact point).
+
+Each element's force acts on its sphere's body at the contact point (N, m, ground).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, ClassVar
 
 import casadi as cs
 
 from nmsm.core.plugin_bases import ContactModel
 
+#: sides of OpenSim's gait ground-reaction convention
+SIDES = ("r", "l")
+
+
+def _labels(prefix: str, torque_prefix: str) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    return (tuple(f"{prefix}_v{a}" for a in "xyz"), tuple(f"{torque_prefix}_{a}" for a in "xyz"),
+            tuple(f"{prefix}_p{a}" for a in "xyz"))
+
 
 class SmoothSphereContact(ContactModel):
-    """A SmoothSphereHalfSpaceForce of the model (no parameters)."""
+    """One SmoothSphereHalfSpaceForce, or the sum of several (one foot); no parameters.
+
+    ``indices``: positions of the elements among the model's force-applying
+    SmoothSphereHalfSpaceForce elements; ``name``: the model's name (element name, or
+    ``ground_force_<side>`` for a foot group).
+    """
 
     type: ClassVar[str] = "smooth_sphere_half_space"
 
-    def __init__(self, model: Any, index: int) -> None:
-        element = [f for f in model.model.contact_forces if f.applies_force][index]
-        self.index = index
-        self.name = element.name
-        self.load_bodies = (model.model.contact_geometry[element.sphere].body,)
-        self.force_labels = tuple(f"{self.name}_force_v{a}" for a in "xyz")
-        self.moment_labels = tuple(f"{self.name}_torque_{a}" for a in "xyz")
-        self.point_labels = tuple(f"{self.name}_force_p{a}" for a in "xyz")
+    def __init__(self, model: Any, index: int | Sequence[int], name: str | None = None) -> None:
+        elements = [f for f in model.model.contact_forces if f.applies_force]
+        self.indices = (index,) if isinstance(index, int) else tuple(index)
+        if not self.indices:
+            raise ValueError("a smooth sphere contact model needs at least one element")
+        chosen = [elements[i] for i in self.indices]
+        self.index = self.indices[0]
+        self.element_names = tuple(e.name for e in chosen)
+        bodies = []
+        for e in chosen:
+            body = model.model.contact_geometry[e.sphere].body
+            if body not in bodies:
+                bodies.append(body)
+        self.load_bodies = tuple(bodies)
+        self._body_of = [bodies.index(model.model.contact_geometry[e.sphere].body) for e in chosen]
+        if name is None and len(chosen) == 1:
+            self.name = chosen[0].name
+            self.force_labels, self.moment_labels, self.point_labels = _labels(f"{self.name}_force",
+                                                                               f"{self.name}_torque")
+        else:
+            self.name = name or "+".join(self.element_names)
+            torque = self.name.replace("_force_", "_torque_") if "_force_" in self.name else f"{self.name}_torque"
+            self.force_labels, self.moment_labels, self.point_labels = _labels(self.name, torque)
 
     @classmethod
     def discover(cls, setup: Any) -> list[ContactModel]:
@@ -36,13 +79,54 @@ class SmoothSphereContact(ContactModel):
         osim = getattr(model, "model", None)
         if osim is None:
             return []
-        n = len([f for f in osim.contact_forces if f.applies_force])
-        return [cls(model, i) for i in range(n)]
+        names = [f.name for f in osim.contact_forces if f.applies_force]
+        if not names:
+            return []
+        groups = cls.foot_groups(names, getattr(setup, "references", {}).get("ground_reactions"))
+        if groups:
+            return [cls(model, indices, f"ground_force_{side}") for side, indices in groups.items()]
+        return [cls(model, i) for i in range(len(names))]
+
+    @staticmethod
+    def foot_groups(names: Sequence[str], tracked: Any) -> dict[str, tuple[int, ...]]:
+        """{side: element indices} when ``tracked`` (ground-reaction splines or None) has
+        OpenSim's gait columns for every side that has elements ending in ``_<side>``,
+        and every element belongs to a side; else {}."""
+        if tracked is None or not hasattr(tracked, "has"):
+            return {}
+        groups = {side: tuple(i for i, n in enumerate(names) if n.endswith(f"_{side}")) for side in SIDES}
+        groups = {side: idx for side, idx in groups.items() if idx}
+        if sum(len(idx) for idx in groups.values()) != len(names):
+            return {}
+        if not groups or not all(tracked.has(f"ground_force_{side}_vx") for side in groups):
+            return {}
+        return groups
 
     def point_function(self, model: Any) -> cs.Function:
         cm = model.casadi
         q, qd, p = cs.SX.sym("q", cm.n), cs.SX.sym("qd", cm.n), cs.SX.sym("p", 0)
         forces, points = cm.contact_force_function()(q, qd)
-        force, point = forces[:, self.index], points[:, self.index]
-        loads = cs.vertcat(force, point, cs.SX.zeros(3, 1))
-        return cs.Function(f"contact_{self.name}", [q, qd, p], [loads, force, cs.cross(point, force), point])
+        loads = cs.SX.zeros(9, len(self.load_bodies))
+        total = cs.SX.zeros(3, 1)
+        moment = cs.SX.zeros(3, 1)
+        weighted = cs.SX.zeros(3, 1)
+        weight = cs.SX(0.0)
+        for j, index in enumerate(self.indices):
+            force, point = forces[:, index], points[:, index]
+            column = self._body_of[j]
+            # several elements on one body: add the forces and their moments about the ground origin
+            torque = cs.cross(point, force)
+            loads[0:3, column] = loads[0:3, column] + force
+            loads[6:9, column] = loads[6:9, column] + torque
+            total = total + force
+            moment = moment + torque
+            normal = cs.fabs(force[1])
+            weighted = weighted + normal * point
+            weight = weight + normal
+        if len(self.indices) == 1:
+            point = points[:, self.indices[0]]
+            loads = cs.vertcat(forces[:, self.indices[0]], point, cs.SX.zeros(3, 1))
+        else:
+            # loads given as (force, point = ground origin, torque about the origin): equivalent
+            point = weighted / (weight + 1e-6)
+        return cs.Function(f"contact_{self.name}", [q, qd, p], [loads, total, moment, point])

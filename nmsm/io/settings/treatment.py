@@ -79,6 +79,33 @@ class TorqueControllerSettings:
 
 
 @attrs.frozen(kw_only=True)
+class MuscleControllerSettings:
+    """``<RCNLMuscleController>``: one activation control per muscle (``individual_muscle``;
+    see :mod:`nmsm.controllers.muscle`). Without a surrogate data directory the exact
+    path geometry of the model is used."""
+
+    surrogate_model_coordinate_list: tuple[str, ...] = setting(
+        "surrogate_model_coordinate_list", kind="names", required=True, example="hip_flexion_r knee_angle_r",
+        doc="Coordinates receiving muscle moments (every coordinate the muscles span)")
+    muscle_list: tuple[str, ...] = setting("muscle_list", kind="names", default=(), doc="Muscles (default: all)")
+    surrogate_model_data_directory: Path | None = setting(
+        "surrogate_model_data_directory", kind="path", path_kind="dir", default=None,
+        doc="Surrogate data (IKData, MAData); omitted: exact path geometry of the .osim")
+    surrogate_model_polynomial_degree: int = setting(
+        "surrogate_model_polynomial_degree", kind="integer", default=5, check=at_least_one, doc="Surrogate degree")
+    epsilon: float = setting("epsilon", kind="number", default=1e-4, check=positive, doc="Surrogate regularization")
+    load_surrogate_model: bool = setting("load_surrogate_model", kind="boolean", default=False, doc="Load surrogate")
+    save_surrogate_model: bool = setting("save_surrogate_model", kind="boolean", default=False, doc="Save surrogate")
+    maximum_shortening_velocity_multiplier: float = setting(
+        "maximum_shortening_velocity_multiplier", kind="number", default=10.0, check=positive,
+        doc="Maximum shortening velocity (optimal fiber lengths per second)")
+    minimum_activation: float = setting("minimum_activation", kind="number", default=0.01, check=non_negative,
+                                        doc="Lower bound of the activations")
+    muscle_force_model: str = setting("muscle_force_model", kind="text", default="nmsm",
+                                      choices=("nmsm", "degroote2016"), doc="Hill model: nmsm or degroote2016")
+
+
+@attrs.frozen(kw_only=True)
 class SynergyControllerSettings:
     """``<RCNLSynergyController>``: muscles driven by synergies through a surrogate muscle model."""
 
@@ -354,6 +381,10 @@ class TreatmentOptimizationSettings:
     torque_controller: TorqueControllerSettings | None = setting(
         "RCNLTorqueController", kind="block", nested=TorqueControllerSettings, default=None, doc="Torque controller"
     )
+    muscle_controller: MuscleControllerSettings | None = setting(
+        "RCNLMuscleController", kind="block", nested=MuscleControllerSettings, default=None, template="comment",
+        doc="Individual muscle activation controller",
+    )
     cost_terms: tuple[TermSpec, ...] = setting(
         "RCNLCostTermSet", kind="terms", term_kind="cost", required=True, examples=_COST_EXAMPLE, doc="Cost terms"
     )
@@ -380,7 +411,8 @@ class TreatmentOptimizationSettings:
 
     @classmethod
     def validate(cls, values: dict[str, Any], ctx: ReadContext) -> None:
-        if values["synergy_controller"] is None and values["torque_controller"] is None:
+        if (values["synergy_controller"] is None and values["torque_controller"] is None
+                and values.get("muscle_controller") is None):
             raise ctx.doc.error(
                 ctx.element,
                 "no controller",
