@@ -96,6 +96,12 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
     if trial is None:
         raise FileNotFoundError(f"{folder} holds no <trial>_states.sto: not a treatment optimization results folder")
     out_dir = Path(output_dir) if output_dir is not None else folder / "plots"
+    # a failed solve's last iterate (``last_iterate/`` with its diagnosis) must not look converged
+    note = " - LAST ITERATE, NOT CONVERGED (diagnosis.txt)" if (folder / "diagnosis.txt").is_file() else ""
+
+    def save(plt, fig, path: Path, title: str) -> Path:
+        return _save(plt, fig, path, title + note)
+
     others = [Path(c) for c in compare]
     written: list[Path] = []
     states = read_storage(folder / f"{trial}_states.sto")
@@ -112,7 +118,7 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
         _plot_columns(axes[row * len(coords):(row + 1) * len(coords)], series, coords, degrees)
         for ax in axes[row * len(coords):(row + 1) * len(coords)]:
             ax.set_ylabel({"Positions": "deg", "Velocities": "deg/s", "Accelerations": "deg/s²"}[kind], fontsize=8)
-    written.append(_save(plt, fig, out_dir / f"{trial}_kinematics.png", f"{trial}: state kinematics"))
+    written.append(save(plt, fig, out_dir / f"{trial}_kinematics.png", f"{trial}: state kinematics"))
     # loads
     ids = _read(folder / "IDData" / f"{trial}.sto")
     torque = _read(folder / f"{trial}_torqueControls.sto")
@@ -127,7 +133,7 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
                 coord = label.rsplit("_", 1)[0]
                 if torque.has(coord):
                     ax.plot(torque.time, torque.column(coord), color="C1", ls=":", label="torque control")
-        written.append(_save(plt, fig, out_dir / f"{trial}_loads.png", f"{trial}: joint loads (N·m, N)"))
+        written.append(save(plt, fig, out_dir / f"{trial}_loads.png", f"{trial}: joint loads (N·m, N)"))
     # controls
     commands = _read(folder / f"{trial}_synergyCommands.sto")
     for table, name in ((torque, "torque controls"), (commands, "synergy commands")):
@@ -137,7 +143,7 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
         fname = f"{trial}_{'torqueControls' if table is torque else 'synergyCommands'}.sto"
         series = [(table, "solution", {"color": "C0"})] + [(_read(o / fname), o.name, {"ls": "--"}) for o in others]
         _plot_columns(axes, series, table.labels)
-        written.append(_save(plt, fig, out_dir / f"{trial}_controls{'' if table is torque else '_synergy'}.png",
+        written.append(save(plt, fig, out_dir / f"{trial}_controls{'' if table is torque else '_synergy'}.png",
                              f"{trial}: {name}"))
     activations = _read(folder / f"{trial}_combinedActivations.sto")
     if activations is not None:
@@ -145,5 +151,5 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
         fname = f"{trial}_combinedActivations.sto"
         series = [(activations, "solution", {"color": "C0"})] + [(_read(o / fname), o.name, {"ls": "--"}) for o in others]
         _plot_columns(axes, series, activations.labels)
-        written.append(_save(plt, fig, out_dir / f"{trial}_activations.png", f"{trial}: muscle activations"))
+        written.append(save(plt, fig, out_dir / f"{trial}_activations.png", f"{trial}: muscle activations"))
     return written

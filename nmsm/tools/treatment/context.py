@@ -204,6 +204,191 @@ class GridView:
         """``compute(self)`` once per grid and ``key`` (for quantities added by plugins)."""
         return self._q.cache((self.grid, "plugin", key), lambda: compute(self))
 
+    # ==== BEGIN catalog DO-goal quantities (whole body, centre of pressure, metabolics) ====
+    # Appended block: centre of mass, central angular momentum, per-foot ground reactions and
+    # centre of pressure, Bhargava metabolic rate, belt speed (terms in nmsm/terms/treatment/
+    # angular_momentum.py, walking_speed.py, metabolic_cost.py, impulse.py,
+    # center_of_pressure.py). Computations: nmsm/tools/treatment/{whole_body,metabolics}.py.
+    def _whole_body(self) -> list[cs.MX]:
+        from nmsm.tools.treatment.whole_body import whole_body_function
+
+        def compute(view: GridView) -> list[cs.MX]:
+            f = self._q.cache(("whole_body_function",), lambda: whole_body_function(self._q.data.model))
+            return view.map_kinematics_function("whole_body", f, "q, qd")
+        return self.cached("whole_body", compute)
+
+    def center_of_mass_position(self) -> cs.MX:
+        """(n, 3) whole-body centre of mass in ground (m)."""
+        return self._whole_body()[0]
+
+    def center_of_mass_velocity(self) -> cs.MX:
+        """(n, 3) velocity of the centre of mass in ground (m/s)."""
+        return self._whole_body()[1]
+
+    def angular_momentum(self) -> cs.MX:
+        """(n, 3) whole-body angular momentum about the centre of mass, ground axes (kg·m²/s)."""
+        return self._whole_body()[2]
+
+    def body_mass(self) -> float:
+        """Total mass of the model's bodies (kg)."""
+        from nmsm.tools.treatment.whole_body import total_mass
+
+        return self._q.cache(("body_mass",), lambda: total_mass(self._q.data.model))
+
+    def foot_contacts(self, hindfoot_body: str) -> list[Any]:
+        """Contact models whose loads act on ``hindfoot_body`` first (an elastic-foundation
+        surface of that hindfoot, or the smooth spheres on that body)."""
+        out = []
+        for c in self._q.data.contact_models:
+            surface = getattr(c, "surface", None)
+            first = getattr(surface, "hindfoot_body", None) or (c.load_bodies[0] if c.load_bodies else None)
+            if first == hindfoot_body:
+                out.append(c)
+        return out
+
+    def foot_ground_reaction(self, hindfoot_body: str) -> tuple[cs.MX, cs.MX, cs.MX]:
+        """Summed over :meth:`foot_contacts`: force (n, 3) N, moment about the ground origin
+        (n, 3) N·m (elastic foundation: its own moment about its floor point, GCP's convention;
+        other contact models: from the loads applied to the bodies) and the first contact's
+        reference point projected on the floor (n, 3) m (y = 0), all in ground."""
+        def compute(view: GridView) -> tuple[cs.MX, cs.MX, cs.MX]:
+            force = moment = point = None
+            from nmsm.controllers.contact.elastic_foundation import ElasticFoundationContact
+            from nmsm.tools.treatment.whole_body import foot_reaction_function
+
+            for contact in self.foot_contacts(hindfoot_body):
+                g = foot_reaction_function(self._q._contact_function(contact), contact.name,
+                                           moment_about_floor_point=isinstance(contact, ElasticFoundationContact))
+                F, M, P = view.map_kinematics_function(("foot_reaction", id(contact)), g, "q, qd", None,
+                                                       (contact.parameters(),))
+                force = F if force is None else force + F
+                moment = M if moment is None else moment + M
+                point = P if point is None else point
+            if force is None:
+                raise KeyError(f"no contact model acts on hindfoot body '{hindfoot_body}'")
+            return force, moment, point
+        return self.cached(("foot_ground_reaction", hindfoot_body), compute)
+
+    def center_of_pressure(self, hindfoot_body: str) -> cs.MX:
+        """(n, 3) modeled centre of pressure of a foot on the floor (m; y = 0): about the
+        reference point P, ``x = P_x + M_z/F̂_y``, ``z = P_z - M_x/F̂_y``,
+        ``F̂_y = F_y + sign(F_y)`` (sign(0) = 1) - catalog §1.4."""
+        def compute(view: GridView) -> cs.MX:
+            F, M_origin, P = view.foot_ground_reaction(hindfoot_body)
+            M = M_origin - _cross_rows(P, F)
+            return _cop(P, F, M)
+        return self.cached(("center_of_pressure", hindfoot_body), compute)
+
+    def tracked_center_of_pressure(self, hindfoot_body: str) -> cs.DM:
+        """(n, 3) experimental centre of pressure (m; y = 0) from the tracked GRF columns of
+        the foot's contact surfaces: about the first surface's electrical centre ``EC``,
+        ``x = EC_x + M_z/F̂_y``, ``z = EC_z - M_x/F̂_y`` (torques act at each EC)."""
+        def compute(view: GridView) -> cs.DM:
+            refs = self._q.data.references["ground_reactions"]
+            t = self._q.reference_times(view.grid)
+            seen: set[tuple[str, ...]] = set()
+            F = M_origin = EC = None
+            for contact in self.foot_contacts(hindfoot_body):
+                labels = tuple(contact.force_labels) + tuple(contact.moment_labels) + tuple(contact.point_labels)
+                if labels in seen:
+                    continue
+                seen.add(labels)
+                f = refs.values(t, 0, contact.force_labels)
+                torque = refs.values(t, 0, contact.moment_labels)
+                centre = refs.values(t, 0, contact.point_labels)
+                m = np.cross(centre, f) + torque
+                F = f if F is None else F + f
+                M_origin = m if M_origin is None else M_origin + m
+                EC = centre if EC is None else EC
+            M = M_origin - np.cross(EC, F)
+            return cs.DM(_cop(EC, F, M))
+        return self.cached(("tracked_center_of_pressure", hindfoot_body), compute)
+
+    def belt_speed(self) -> Any:
+        """Mean treadmill belt speed (m/s) of the contact surfaces that have one (0 if none);
+        an MX when a model function (``applyBeltSpeedParameter``) made it a parameter."""
+        from nmsm.model.foot_contact import CONTACT_PARAMETERS
+
+        values = [c.values[CONTACT_PARAMETERS.index("belt_speed")] for c in self._q.data.contact_models
+                  if hasattr(c, "set_parameter") and hasattr(c, "values")]
+        if not values:
+            return 0.0
+        return sum((cs.MX(v) for v in values), cs.MX(0)) / len(values)
+
+    def metabolic_rate(self) -> cs.MX:
+        """(n, 1) whole-body metabolic rate Ė (W): smoothed Bhargava model of every muscle of
+        the muscle/synergy controllers plus the basal rate (:mod:`~nmsm.tools.treatment.metabolics`)."""
+        from nmsm.tools.treatment.metabolics import BASAL_RATE, metabolic_point_function
+
+        def compute(view: GridView) -> cs.MX:
+            names = self._q.muscle_names
+            params = self._q.cache(("metabolic_parameters",), self._metabolic_parameter_row)
+            f = self._q.cache(("metabolic_function",), lambda: metabolic_point_function(len(names)))
+            (rate,) = map_rows(f, view.muscle_activations(), self._q.muscle_quantity(view.grid, "normalized_fiber_length"),
+                               self._q.muscle_quantity(view.grid, "normalized_fiber_velocity"), params,
+                               parallel=self._q.parallel)
+            return rate + BASAL_RATE * self.body_mass()
+        return self.cached("metabolic_rate", compute)
+
+    def _metabolic_parameter_row(self) -> cs.MX:
+        """(1, 4 M) [F0, l_o, cos α, vmax] of :attr:`muscle_names` (MX: modifiers may set them)."""
+        found: dict[str, tuple[Any, Any, float, float]] = {}
+        for controller in self._q.data.controllers:
+            model = getattr(controller, "muscle_model", None)
+            if model is None:
+                continue
+            for j, m in enumerate(model.muscles):
+                if m not in found:
+                    values = model.parameters[m]
+                    found[m] = (values["max_isometric_force"], values["optimal_fiber_length"],
+                                float(np.cos(model.pennation[j])), float(model.vmax_factor))
+        missing = [m for m in self._q.muscle_names if m not in found]
+        if missing:
+            raise KeyError(f"muscles without Hill parameters: {', '.join(missing)}")
+        rows = [found[m] for m in self._q.muscle_names]
+        return cs.horzcat(*[cs.MX(r[k]) for k in range(4) for r in rows])
+
+    def initial_guess_value(self, expression: Any) -> np.ndarray:
+        """Numeric value of an expression of the decision variables at the initial guess."""
+        problem = self._q.trajectory.problem
+        return problem.evaluate(expression, problem.initial_scaled())
+
+    def require_hindfoot_body(self, term: Any, body: str, *, tracked: bool = False,
+                              element: str = "<hindfoot_body_list>") -> None:
+        """``body`` must carry a contact model (and, with ``tracked``, its GRF columns)."""
+        contacts = self.foot_contacts(body)
+        if not contacts:
+            have = sorted({getattr(getattr(c, "surface", None), "hindfoot_body", None) or c.load_bodies[0]
+                           for c in self._q.data.contact_models if c.load_bodies})
+            raise term.error(f"no contact model acts on hindfoot body '{body}'", element=element,
+                             expected="one of " + (", ".join(have) or "(no contact model: add contact surfaces to "
+                                                   "the .osimx or contact forces to the model)"))
+        if tracked:
+            refs = self._q.data.references.get("ground_reactions")
+            for c in contacts:
+                for label in (*c.force_labels, *c.moment_labels, *c.point_labels):
+                    if refs is None or not refs.has(label):
+                        raise term.error(f"no column '{label}' in the tracked ground reactions (GRFData) for the "
+                                         f"centre of pressure of '{body}'", element=element)
+
+    def require_whole_body(self, term: Any) -> None:
+        from nmsm.tools.treatment.whole_body import supports_whole_body
+
+        if not supports_whole_body(self._q.data.model):
+            raise term.error("the model has no mass properties for whole-body quantities")
+
+    def require_metabolic_model(self, term: Any) -> None:
+        """The problem must have muscles with Hill parameters (synergy or muscle controller)."""
+        if not self._q.muscle_names:
+            raise term.error("a metabolic cost needs muscles: add a synergy or individual-muscle controller "
+                             "(a torque-driven problem has no muscle energetics)", element="<type>")
+        try:
+            self._q.cache(("metabolic_parameters",), self._metabolic_parameter_row)
+        except KeyError as exc:
+            raise term.error(str(exc.args[0]), element="<type>") from None
+    # ==== END catalog DO-goal quantities ====
+
+
 
 class TreatmentContext(GridView):
     """What terms receive: the collocation-point view, terminal views and problem-wide data."""
@@ -793,3 +978,20 @@ class _Quantities:
                 return getter(group, initial=initial)
         raise KeyError("no synergy controller in this problem")
 
+
+# ==== BEGIN catalog DO-goal helpers (centre of pressure) ====
+def _cross_rows(a: Any, b: Any) -> Any:
+    """Row-wise cross product of (n, 3) MX matrices."""
+    return cs.horzcat(a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                      a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+
+
+def _cop(point: Any, force: Any, moment: Any) -> Any:
+    """(n, 3) centre of pressure on y = 0 from the force and its moment about ``point``
+    (catalog §1.4: ``F̂_y = F_y + sign(F_y)``, sign(0) = 1)."""
+    if isinstance(force, np.ndarray):
+        fy = force[:, 1] + np.where(force[:, 1] >= 0, 1.0, -1.0)
+        return np.c_[point[:, 0] + moment[:, 2] / fy, np.zeros(len(fy)), point[:, 2] - moment[:, 0] / fy]
+    fy = force[:, 1] + cs.if_else(force[:, 1] >= 0, 1.0, -1.0)
+    return cs.horzcat(point[:, 0] + moment[:, 2] / fy, cs.MX(force.shape[0], 1), point[:, 2] - moment[:, 0] / fy)
+# ==== END catalog DO-goal helpers ====

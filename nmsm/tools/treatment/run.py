@@ -13,7 +13,9 @@ Options (keyword arguments) are the fields of
 
 Results are staged and moved into the results folder only when the solve succeeded. A
 failed solve writes its last iterate and a diagnosis into ``<results>/last_iterate/`` and
-raises :class:`~nmsm.errors.SolverError`.
+raises :class:`~nmsm.errors.SolverError`. A results folder that is one of the input folders
+(tracked quantities, initial guess, guess) is refused before solving, and the input data files
+are never overwritten.
 """
 
 from __future__ import annotations
@@ -138,6 +140,29 @@ def _ipopt_kwargs(prepared: Prepared, options: TreatmentOptions, log: Path | Non
     }
 
 
+def _input_files(prepared: Prepared) -> list[Path]:
+    """Every data file the problem was built from (never to be overwritten by results)."""
+    f = prepared.files
+    tables = [f.tracked_ik, f.tracked_id, f.tracked_grf, f.initial_ik, f.initial_id, f.synergy_weights,
+              *f.results.values()]
+    return [Path(t.source) for t in tables if t is not None and getattr(t, "source", None)]
+
+
+def _check_results_apart(settings: Any, options: TreatmentOptions, prepared: Prepared) -> None:
+    """Refuse, before solving, a results folder that is one of the input folders."""
+    path = Path(options.results_directory or settings.results_directory).resolve()
+    inputs = {"tracked quantities": prepared.files.tracked_directory,
+              "initial guess": prepared.files.initial_directory}
+    if options.guess_directory is not None:
+        inputs["guess"] = options.guess_directory
+    for what, folder in inputs.items():
+        if Path(folder).resolve() == path:
+            element = "<results_directory>" if options.results_directory is None else None
+            raise InputError(f"the results folder {path} is the {what} folder: the results would overwrite the files "
+                             "they are computed from", file=settings.settings_file, element=element,
+                             expected="a results folder apart from the input folders (e.g. results_directory=...)")
+
+
 def _results_directory(settings: Any, options: TreatmentOptions, inputs: list[Path]) -> ResultsDirectory:
     path = Path(options.results_directory or settings.results_directory)
     try:
@@ -174,7 +199,11 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
         tsol = TreatmentSolution(prepared.built, solution, trial)
         return TreatmentRun(prepared, solution, tsol, convergence_summary(prepared.built, solution), initial_cost,
                             None, [], build_time)
-    results = _results_directory(settings, opts, [Path(path), Path(settings.input_model_file)]) if opts.write_results else None
+    results = None
+    if opts.write_results:
+        _check_results_apart(settings, opts, prepared)
+        results = _results_directory(settings, opts, [Path(path), Path(settings.input_model_file),
+                                                      *_input_files(prepared)])
     log_dir = Path(results.path) / ".ipopt" if results is not None else None
     if log_dir is not None:
         log_dir.mkdir(parents=True, exist_ok=True)

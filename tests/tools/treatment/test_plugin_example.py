@@ -49,6 +49,11 @@ def test_design_optimization_with_the_plugin(shared_data: Path, tmp_path: Path, 
     a1 = float(run.result.value(ctx.integrate(ctx.control("RightLeg_1") ** 2)).ravel()[0]) ** 0.5
     a4 = float(run.result.value(ctx.integrate(ctx.control("RightLeg_4") ** 2)).ravel()[0]) ** 0.5
     assert abs(a1 - a4) < 0.05 * 3
+    # the synergy-driven results draw with `nmsm plot`'s treatment plotter
+    from nmsm.plots.treatment import plot_treatment_results
+
+    names = {p.name for p in plot_treatment_results(tmp_path, tmp_path / "plots")}
+    assert {"drive_kick1_activations.png", "drive_kick1_kinematics.png"} <= names, names
 
 
 def test_unknown_model_function_is_a_clear_error(shared_data: Path, tmp_path: Path, monkeypatch) -> None:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from nmsm.errors import InputError, SolverError
@@ -87,3 +89,76 @@ def test_unwritable_results_folder(shared_data: Path, tmp_path: Path) -> None:
     blocker.write_text("not a folder")
     with pytest.raises(InputError, match="cannot create the results folder"):
         _quiet_run(path, results_directory=blocker / "results", print_level=0)
+
+
+def test_verification_coordinate_both_controlled_and_tracked_is_reported(shared_data: Path, tmp_path: Path) -> None:
+    path = _settings(shared_data, tmp_path, tool="VerificationOptimizationTool", costs=COORDINATES)
+    with pytest.warns(UserWarning, match="VO: state coordinate 'knee_angle_r' is both controlled and tracked"):
+        run_settings(path, evaluate_only=True)
+
+
+def test_initial_guess_outside_the_bounds_is_reported(shared_data: Path, tmp_path: Path) -> None:
+    from nmsm.io.storage import read_storage, table_from_columns, write_storage
+
+    states = ("hip_flexion_r", "knee_angle_r", "ankle_angle_r")
+    ik = read_storage(shared_data / "treatment" / "torque_kick_tutorial" / "preprocessed" / "IKData" / "drive_kick1.sto")
+    ik = ik.to_radians(states)
+    columns = {c: ik.column(c) + (5.0 if c == "hip_flexion_r" else 0.0) for c in states}
+    columns |= {f"{c}_u": np.gradient(ik.column(c), ik.time) for c in states}
+    guess = tmp_path / "guess"
+    guess.mkdir()
+    write_storage(guess / "drive_kick1_states.sto", table_from_columns(ik.time, columns))
+    path = _settings(shared_data, tmp_path)
+    with pytest.warns(UserWarning, match=r"initial guess violates variable bounds.*\n.*state 'hip_flexion_r': "
+                                         r"initial guess spans \[.*\] outside the bounds \[.*\]") as record:
+        run = run_settings(path, initial_guess_directory=guess, evaluate_only=True)
+    assert not any("knee_angle_r'" in str(w.message) for w in record if "violates" in str(w.message))
+    # IPOPT starts from the projection onto the bounds
+    lo, hi = run.prepared.built.problem.bounds_scaled()
+    assert np.all(run.solution.x_scaled >= lo) and np.all(run.solution.x_scaled <= hi)
+
+
+INFEASIBLE = ("<RCNLConstraintTerm><is_enabled>true</is_enabled><type>generalized_coordinate_value</type>"
+              "<coordinate_list>knee_angle_r</coordinate_list><max_error>6</max_error><min_error>5</min_error>"
+              "</RCNLConstraintTerm></RCNLConstraintTermSet>")
+
+
+def test_infeasible_problem_is_diagnosed_and_never_looks_converged(shared_data: Path, tmp_path: Path) -> None:
+    # knee angle in [5, 6] rad while its bounds (range rule on the data) stay far below;
+    # a coarse mesh (4 x 3 points) keeps IPOPT's infeasibility detection short
+    data = shared_data / "treatment" / "torque_kick_tutorial"
+    solver = tmp_path / "solver.xml"
+    solver.write_text((data / "GpopsSettings.xml").read_text()
+                      .replace("<setup_mesh_phase_intervals>25<", "<setup_mesh_phase_intervals>4<")
+                      .replace("<setup_mesh_phase_colpoints_per_Interval>4<", "<setup_mesh_phase_colpoints_per_Interval>3<"))
+    path = _settings(shared_data, tmp_path)
+    path.write_text(path.read_text().replace("</RCNLConstraintTermSet>", INFEASIBLE)
+                    .replace(str(data / "GpopsSettings.xml"), str(solver)))
+    with pytest.raises(SolverError, match="did not converge") as info:
+        _quiet_run(path, max_iterations=200, print_level=0)
+    saved = Path(info.value.last_iterate_path)
+    diagnosis = (saved / "diagnosis.txt").read_text()
+    assert "Infeasible" in diagnosis and "locally infeasible" in diagnosis
+    assert re.search(r"\[VIOLATED\] generalized_coordinate_value:knee_angle_r .*settings.xml:\d+\)", diagnosis)
+    assert (saved / "drive_kick1_convergence.txt").is_file()
+    assert not (tmp_path / "results" / "drive_kick1_states.sto").exists()
+    assert not (tmp_path / "results" / "IKData").exists()
+
+
+def test_constraint_bounds_in_the_wrong_order(shared_data: Path, tmp_path: Path) -> None:
+    path = _settings(shared_data, tmp_path)
+    path.write_text(path.read_text().replace("<max_error>0.1</max_error><min_error>-0.1</min_error>",
+                                             "<max_error>-0.1</max_error><min_error>0.1</min_error>"))
+    with pytest.raises(InputError, match=r"settings.xml.*min_error 0.1 > max_error -0.1"):
+        _quiet_run(path, evaluate_only=True)
+
+
+def test_results_folder_cannot_be_an_input_folder(shared_data: Path, tmp_path: Path) -> None:
+    toy = shared_data / "treatment" / "toy_arm"
+    to = tmp_path / "to"
+    _quiet_run(toy / "tracking_optimization" / "TorqueDrivenTOSettings.xml", results_directory=to, print_level=0)
+    before = (to / "arm1_states.sto").read_bytes()
+    with pytest.raises(InputError, match="is the tracked quantities folder: the results would overwrite"):
+        _quiet_run(toy / "verification_optimization" / "TorqueDrivenVOSettings.xml", results_directory=to,
+                   initial_guess_directory=to, tracked_quantities_directory=to, print_level=0)
+    assert (to / "arm1_states.sto").read_bytes() == before

@@ -15,7 +15,10 @@ SAMPLE = {
     "coordinate": "q0", "load": "q0_moment", "marker": "tip_1", "axis": "x", "body": "link_1",
     "controller": "q0", "sequence": "xyz",
 }
-NEEDS_MUSCLES = {"muscle", "synergy", "synergies", "synergy_pairs", "force", "moment"}  # + contact: own test
+NEEDS_MUSCLES = {"muscle", "synergy", "synergies", "synergy_pairs", "force", "moment",
+                 "hindfoot_body"}  # + contact: own test
+# metabolic goals need muscles but name none (test_treatment_catalog_goals.py tests them)
+NEEDS_MUSCLE_TYPES = ("metabolic_cost",)
 
 
 def _builtin_terms() -> list[type]:
@@ -25,7 +28,7 @@ def _builtin_terms() -> list[type]:
         for item in registry.items(kind):
             if item.distribution != "nmsm" or not item.tools & {"TO", "VO", "DO"}:
                 continue
-            if NEEDS_MUSCLES & set(item.cls.xml_fields()):
+            if NEEDS_MUSCLES & set(item.cls.xml_fields()) or any(t in item.name for t in NEEDS_MUSCLE_TYPES):
                 continue
             out.append(item.cls)
     return out
