@@ -51,7 +51,7 @@ def _checks(folder: Path, results: Path, ran: set[str]) -> list[recovery.Check]:
     if "mtp" in ran:
         out += recovery.mtp_checks(truth, truth_dir, results / "mtp")
     if "ncp" in ran:
-        out += recovery.ncp_checks(truth, truth_dir, results / "ncp")
+        out += recovery.ncp_checks(truth, truth_dir, results / "ncp", results / "mtp")
     if "gcp" in ran:
         out += recovery.gcp_checks(truth, results / "gcp")
     if "to" in ran:

@@ -9,7 +9,7 @@
     subject/calibration/JMPSettings.xml
     subject/gait.trc                 markers of the simulated gait (100 Hz, mm)
     subject/gait_grf.mot, .xml       its ground reactions (1000 Hz) and their ExternalLoads
-    subject/gait_emg.mot             raw EMG of the eight channels (1000 Hz, mV, -0.3-1 s)
+    subject/gait_emg.mot             raw EMG of the eight channels (1000 Hz, mV, -0.3-1.2 s)
     truth/true.osim                  the subject's true model
     truth/true_contact.osimx         the true foot springs
     truth/truth.json                 every known parameter (:func:`read_truth`)
@@ -40,7 +40,7 @@ from nmsm.examples.subject_motion import HEEL_STRIKE, foot_pose, leg_inverse_kin
 #: the gait trial (heel strike, stance, toe-off) the personalization and treatment tools
 #: use, and GCP's window
 SIMULATION = (0.0, 1.05)
-EMG_SPAN = (-0.3, 1.0)
+EMG_SPAN = (-0.3, 1.2)
 TRIAL_WINDOW = (0.21, 0.79)
 GCP_WINDOW = (0.21, 0.79)
 #: sample rates (Hz) of the marker, force-plate and EMG files

@@ -19,6 +19,14 @@ from nmsm.examples.subject import EMG_LOW_PASS, GCP_WINDOW, GRF_NAME, SIMULATION
 #: the stages of the example, in order (``nmsm example <stage>`` runs up to one of them)
 STAGES = ("jmp", "analysis", "preprocess", "mtp", "ncp", "gcp", "surrogate", "to", "vo", "do")
 PREPROCESSED_TRIAL = f"{TRIAL}_1"
+#: EMG padding (s) before and after the trial: the padded EMG starts at -0.14 s, before the
+#: simulation, where the recorded excitations are constant. MTP samples the EMG spline at
+#: ``t - delay`` from the first padded frame on, so for the first ``delay`` seconds it
+#: extrapolates the spline's first cubic piece (as the original's ``ppval`` does); on a
+#: steep envelope that gives large negative excitations, and the activation dynamics
+#: (``(c1 e + c2) < 0``) amplify them into a transient that outlasts a 0.2 s padding
+#: (docs/pipeline.md, "The built-in example").
+EMG_PADDING = 0.35
 
 
 def _term(kind: str, error: float, **fields: str) -> str:
@@ -65,6 +73,7 @@ def preprocess_xml(subject: Subject, folder: Path) -> str:
         <rows_per_trial>101</rows_per_trial>
         <cutoff_frequency>15</cutoff_frequency>
         <emg_low_pass_frequency>{EMG_LOW_PASS:g}</emg_low_pass_frequency>
+        <emg_padding_time>{EMG_PADDING:g}</emg_padding_time>
       </DataPreprocessingTool>"""
 
 
@@ -126,7 +135,11 @@ def gcp_xml(subject: Subject, folder: Path) -> str:
     markers = sm.FOOT_MARKERS
     terms = lambda v, h, m: (_term("marker_position", 0.002) + _term("rotation", 0.01)  # noqa: E731
                              + _term("vertical_grf", v) + _term("horizontal_grf", h)
-                             + _term("ground_reaction_moment", m))
+                             + _term("ground_reaction_moment", m)
+                             # as the original's tutorial: neighbouring springs alike (N/m); without it
+                             # the heel-to-toe stiffness profile trades off against the foot
+                             # kinematics (43 % RMS spring-constant error instead of 27 %)
+                             + _term("neighbor_spring_constant", 500))
     flags = ("<springConstants>true</springConstants><dampingFactor>true</dampingFactor>"
              "<dynamicFrictionCoefficient>true</dynamicFrictionCoefficient>"
              "<viscousFrictionCoefficient>true</viscousFrictionCoefficient>"
