@@ -95,7 +95,10 @@ def _toes_pose(osimx_path: Path, associated: str, surface: OsimxContactSurface) 
     from nmsm.errors import NmsmError
     from nmsm.model.osim import load_model
 
-    candidates = [Path(associated), osimx_path.parent / Path(associated.replace("\\", "/")).name]
+    name = Path(associated.replace("\\", "/")).name
+    # the associated path as written, else a file of that name next to the .osimx or up to
+    # three folders above it (a results folder inside the settings folder)
+    candidates = [Path(associated)] + [folder / name for folder in list(osimx_path.resolve().parents)[:4]]
     model_path = next((p for p in candidates if p.is_file()), None)
     if model_path is None:
         return None

@@ -27,6 +27,7 @@ import scipy.optimize
 import scipy.sparse
 
 from nmsm.core.problem import OptimizationProblem, Solution
+from nmsm.tools.gcp.blas_threads import single_threaded_blas
 from nmsm.tools.gcp.problem import TaskProblem
 
 
@@ -112,10 +113,11 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
     if free.size == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
-        result = scipy.optimize.least_squares(
-            lambda xf: lifted.residuals(full(xf)), x0[free], jac=lambda xf: lifted.jacobian(full(xf))[:, free],
-            bounds=(lo[free], hi[free]), method="trf", tr_solver="lsmr", ftol=ftol, xtol=xtol, gtol=gtol,
-            max_nfev=max_nfev, verbose=verbose)
+        with single_threaded_blas():  # LSMR's many small BLAS calls (nmsm.tools.gcp.blas_threads)
+            result = scipy.optimize.least_squares(
+                lambda xf: lifted.residuals(full(xf)), x0[free], jac=lambda xf: lifted.jacobian(full(xf))[:, free],
+                bounds=(lo[free], hi[free]), method="trf", tr_solver="lsmr", ftol=ftol, xtol=xtol, gtol=gtol,
+                max_nfev=max_nfev, verbose=verbose)
         x_opt, status, nfev, success = full(result.x), str(result.message), int(result.nfev), bool(result.status > 0)
     wall = time.perf_counter() - start
     lifted.store(x_opt)

@@ -38,3 +38,13 @@ def test_lifted_jacobian_is_exact(synthetic_case):
         np.testing.assert_allclose(lifted.residuals(x), np.array(r_direct).ravel(), rtol=1e-12, atol=1e-10)
         difference = lifted.jacobian(x) - _sparse(j_direct)
         assert abs(difference).max() <= 1e-9 * max(1.0, abs(_sparse(j_direct)).max())
+
+
+def test_single_threaded_blas_sets_and_restores_thread_counts():
+    from nmsm.tools.gcp.blas_threads import _controls, single_threaded_blas
+
+    controls = _controls()
+    before = [get() for _, get in controls]
+    with single_threaded_blas():
+        assert all(get() == 1 for _, get in controls)
+    assert [get() for _, get in controls] == before
