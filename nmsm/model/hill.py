@@ -67,6 +67,8 @@ ACTIVATION_NONLINEARITY_G = (
     17.227022969058535,
     0.884220539986325,
 )
+#: floor of the squared active force-length widths (see :func:`active_force_length`)
+ACTIVE_WIDTH_FLOOR = 1e-20
 #: deactivation time constant / activation time constant
 DEACTIVATION_RATIO = 4.0
 #: default maximum shortening velocity, optimal fiber lengths per second
@@ -104,13 +106,21 @@ def softplus(x: Any) -> Any:
 # ----- force-length-velocity curves -------------------------------------------------------
 def active_force_length(normalized_length: Any) -> Any:
     """Normalized active fiber force ``f_L`` (-) at normalized fiber length (-)."""
-    ops = _ops(normalized_length)
     l = normalized_length
+    casadi = _is_casadi(l)
+    ops = _ops(l)
+    if not casadi:
+        l = np.asarray(l, dtype=float)
     b1, b2, b3, b4 = ACTIVE_FORCE_LENGTH_B
     total = 0
     for i in range(3):
         width = b3[i] + b4[i] * l
-        total = total + b1[i] * ops.exp(-0.5 * (l - b2[i]) ** 2 / width**2)
+        squared = width**2
+        if b4[i] != 0.0:
+            # the second Gaussian's width vanishes at l = 0.1465; a floor keeps the value
+            # (0 there) and its derivatives finite, and changes nothing for |width| > 1e-10
+            squared = ops.fmax(squared, ACTIVE_WIDTH_FLOOR) if casadi else np.maximum(squared, ACTIVE_WIDTH_FLOOR)
+        total = total + b1[i] * ops.exp(-0.5 * (l - b2[i]) ** 2 / squared)
     return total
 
 

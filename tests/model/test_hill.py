@@ -112,3 +112,23 @@ def test_clip_negative():
     smooth = hill.clip_negative(x, 1e-4)
     assert np.all(smooth >= hill.clip_negative(x))
     assert np.all(smooth - hill.clip_negative(x) <= 0.5e-4 + 1e-15)
+
+
+def test_active_force_length_guarded_where_a_width_vanishes():
+    """The second Gaussian's width ``b3 + b4 l`` is 0 at l = 0.1465 (a fiber far too short,
+    e.g. tendon slack length driven up to the muscle-tendon length): value and exact
+    derivatives stay finite, and nothing changes away from that point."""
+    b3, b4 = hill.ACTIVE_FORCE_LENGTH_B[2][1], hill.ACTIVE_FORCE_LENGTH_B[3][1]
+    singular = -b3 / b4
+    x = cs.SX.sym("x")
+    f = hill.active_force_length(x)
+    fun = cs.Function("f", [x], [f, cs.gradient(f, x), cs.hessian(f, x)[0]])
+    for value in (singular, -2.0, 0.0, 1e-3):
+        assert all(np.isfinite(float(v)) for v in fun(value))
+    with np.errstate(divide="raise", invalid="raise", over="raise"):
+        assert np.isfinite(hill.active_force_length(np.array([singular, -5.0, 0.0])).all())
+    # away from the point the floor changes nothing: compare with the unguarded formula
+    l = np.linspace(0.3, 1.8, 31)
+    b1, b2, b3s, b4s = hill.ACTIVE_FORCE_LENGTH_B
+    plain = sum(b1[i] * np.exp(-0.5 * (l - b2[i]) ** 2 / (b3s[i] + b4s[i] * l) ** 2) for i in range(3))
+    assert np.array_equal(hill.active_force_length(l), plain)

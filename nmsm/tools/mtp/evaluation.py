@@ -12,6 +12,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.errors import InputError
 from nmsm.model import hill
 from nmsm.tools.mtp.model import MuscleDesign, TrialModel
 from nmsm.tools.mtp.problem import MtpData, MtpState, modeled_trials
@@ -79,3 +80,27 @@ def initial_fiber_lengths(data: MtpData) -> list[np.ndarray]:
         hill.normalized_fiber_length(t.muscle_tendon_length, mus.optimal_fiber_length, mus.tendon_slack_length, mus.pennation_angle)
         for t in data.trials
     ]
+
+
+def check_fiber_lengths(data: MtpData, *, stage: str, source: str | None = None) -> None:
+    """Refuse muscles whose fibers have no positive length at the start of a stage.
+
+    ``L_MT - l_ts <= 0`` (tendon slack length at or above the muscle-tendon length, e.g. a
+    bad ``.osimx`` or an MTLI result) gives normalized fiber lengths <= 0 where the Hill
+    curves are meaningless and the optimization cannot recover within the scale-factor
+    bounds: an :class:`InputError` naming muscle, trial and lengths instead.
+    """
+    mus = data.muscles
+    for trial, lengths in zip(data.trials, initial_fiber_lengths(data)):
+        bad = np.flatnonzero(~np.all(np.isfinite(lengths) & (lengths > 0), axis=0))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                f"{stage}: muscle '{mus.names[i]}' has tendon slack length {mus.tendon_slack_length[i]:.4g} m but "
+                f"muscle-tendon length down to {trial.muscle_tendon_length[:, i].min():.4g} m in trial "
+                f"'{trial.name}' (normalized fiber length {lengths[:, i].min():.3g})"
+                + (f"; also {', '.join(mus.names[j] for j in bad[1:])}" if bad.size > 1 else ""),
+                file=source,
+                element="<tendon_slack_length>",
+                expected="0 < tendon slack length < the muscle-tendon length in every frame",
+            )

@@ -12,7 +12,7 @@ block                                 unit       init    bounds
 ``emg_scale``                         -          0.5     [0.05, 1]
 ``optimal_fiber_length_scale``        -          1       [0.6, 1.4]
 ``tendon_slack_length_scale``         -          1       [0.6, 1.4]
-``synergy_weights`` (SynX)            -          0       [-100, 100]
+``synergy_weights`` (SynX)            -          0       [-100, 100] (NMF: extrapolation >= 0)
 ====================================  =========  ======  ==============
 
 Normalized fiber lengths stay in [0.3, 1.3]: by default bounded frame by frame; the
@@ -198,7 +198,7 @@ def build_task_problem(
     design = MuscleDesign(**values)
     weights: Any = cs.MX(0, 1)
     if data.synx is not None:
-        low, high = SYNERGY_WEIGHT_BOUNDS
+        low, high = data.synx.weight_bounds(*SYNERGY_WEIGHT_BOUNDS)
         # scale 1: typical weights are O(0.1-1), far below the +-100 bounds
         weights = problem.variable("synergy_weights", np.clip(state.synergy_weights, low, high), low, high, scale=1.0)
     chains = list(chains) if chains is not None else data.chains()
@@ -240,7 +240,7 @@ def build_task_problem(
                                    CONSTRAINT_MIN_LENGTH, CONSTRAINT_MAX_LENGTH)
     else:
         raise ValueError(f"fiber_length_limits must be 'frames' or 'softmax', got '{fiber_length_limits}'")
-    if data.synx is not None and data.synx.method == "PCA":
+    if data.synx is not None and data.synx.missing_muscles:
         problem.add_constraint("extrapolated_excitation_0_1", data.synx.extrapolated_bounds_expression(weights), 0.0, 1.0)
     return problem, ctx
 

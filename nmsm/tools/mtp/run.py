@@ -36,7 +36,7 @@ from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
 from nmsm.tools.mtp import outputs
 from nmsm.tools.mtp.data import TrialData, check_same_frame_counts, find_prefixes, load_trial
 from nmsm.tools.mtp.derivatives import blockwise_derivatives
-from nmsm.tools.mtp.evaluation import ModeledValues, evaluate, initial_fiber_lengths
+from nmsm.tools.mtp.evaluation import ModeledValues, check_fiber_lengths, evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model_info import muscle_parameters, muscles_crossing
 from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, passive_moments_at, run_mtli
 from nmsm.tools.mtp.mtli_model import PassiveTrial
@@ -177,6 +177,8 @@ def prepare(settings_file: str | os.PathLike[str], *, emg_spline_stride: int = 4
         )
     data = MtpData(muscles, coordinates, trials, channels, activation_groups, fiber_groups, synx,
                    float(settings.v_max_factor), int(emg_spline_stride))
+    check_fiber_lengths(data, stage="MTP input",
+                        source=str(settings.input_osimx_file or settings.input_model_file))
     synx_terms = tuple(t for t in build_terms(list(synx_settings.cost_terms), "SynX") if isinstance(t, CostTerm)) \
         if synx_settings.is_enabled else ()
     tasks = tuple(task_settings(t, synx_terms) for t in settings.tasks)
@@ -209,7 +211,9 @@ def initialize_lengths(setup: MtpSetup) -> tuple[MtpData, MtliResult | None]:
     gait = [t.muscle_tendon_length for t in setup.data.trials]
     result = run_mtli(setup.data.muscles, gait, setup.passive_trials, setup.data.fiber_length_groups,
                       setup.mtli_terms, mtli_options(setup))
-    return attrs.evolve(setup.data, muscles=result.muscles), result
+    data = attrs.evolve(setup.data, muscles=result.muscles)
+    check_fiber_lengths(data, stage="after MTLI")
+    return data, result
 
 
 def solve_tasks(

@@ -12,7 +12,10 @@ excitation from the same kind of commands (tools.md §4.5):
   component positive); each extrapolated excitation is ``u = C w + b``;
 * **NMF** (the original's path is broken; done here as intended): non-negative commands
   ``C`` (frames * trials, K) from multiplicative-update NMF with several replicates,
-  scaled by the row sums of the synergy vectors; ``u = C w`` (no bias).
+  scaled by the row sums of the synergy vectors; ``u = C w`` (no bias) with extrapolation
+  weights ``w >= 0``, so extrapolated excitations are non-negative combinations of
+  non-negative synergy excitations. With either method the extrapolated excitations are
+  constrained to [0, 1] (the original's linear inequalities).
 
 Design-variable layout (the original's order):
 
@@ -40,6 +43,8 @@ import numpy as np
 from nmsm.errors import InputError
 
 CATEGORIZATIONS = ("trial", "task", "subject")
+#: negatives of processed EMG down to this fraction of the peak are filtering round-off (NMF clips them)
+NEGATIVE_ROUNDOFF = 1e-9
 METHODS = ("PCA", "NMF")
 
 
@@ -118,8 +123,13 @@ def nmf(data: np.ndarray, rank: int, *, replicates: int = 20, max_iterations: in
     seeded, so results are reproducible.
     """
     x = np.asarray(data, dtype=float)
-    if np.any(x < 0):
-        raise InputError("NMF needs non-negative EMG", element="EMGData", expected="processed (rectified) EMG >= 0")
+    # low-pass filtering leaves round-off negatives (~1e-19) in processed EMG: clipped;
+    # anything larger is not rectified EMG
+    roundoff = NEGATIVE_ROUNDOFF * max(float(np.abs(x).max(initial=0.0)), 1.0)
+    if np.any(x < -roundoff):
+        raise InputError(f"NMF needs non-negative EMG; smallest value {x.min():.3g}", element="EMGData",
+                         expected="processed (rectified, low-pass filtered) EMG >= 0")
+    x = np.maximum(x, 0.0)
     rng = np.random.default_rng(seed)
     best: tuple[float, np.ndarray, np.ndarray] | None = None
     eps = 1e-12
@@ -255,6 +265,19 @@ class SynergyExtrapolation:
             x = cs.horzcat(*cols)
             out.append(x * cs.repmat(scale, self.n_frames, 1) + cs.horzcat(*extra))
         return out
+
+    def weight_bounds(self, low: float = -100.0, high: float = 100.0) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of the weight vector: ``[low, high]``; with NMF the extrapolation weights are >= 0.
+
+        NMF commands are non-negative, so non-negative weights keep every extrapolated
+        excitation a non-negative combination of synergy excitations (the point of NMF);
+        residual weights stay signed (a residual corrects measured EMG up or down).
+        """
+        lower = np.full(self.n_weights, float(low))
+        upper = np.full(self.n_weights, float(high))
+        if self.method.upper() == "NMF":
+            lower[: self.n_extrapolation_weights] = 0.0
+        return lower, upper
 
     def extrapolated_bounds_expression(self, weights: Any) -> cs.MX:
         """All extrapolated (unscaled) excitations stacked: the original bounds them to [0, 1]."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -116,3 +117,34 @@ def test_zero_tendon_slack_length_is_rejected(case):
     with pytest.raises(InputError) as info:
         prepare(write_settings(folder, tutorial, osimx=str(osimx)))
     assert "tendon_slack_length" in str(info.value) and "soleus_r" in str(info.value)
+
+
+def test_tendon_slack_length_above_muscle_tendon_length(case):
+    """l_ts >= L_MT (no fiber left): refused up front, naming muscle, trial and lengths."""
+    folder, tutorial = case
+    osimx = folder / "long.osimx"
+    osimx.write_text("""<NMSMPipelineDocument Version="1.5.3"><OsimxModel name="m">
+ <associated_osim_model>m.osim</associated_osim_model><RCNLMuscleSet>
+ <RCNLMuscle name="soleus_r"><tendon_slack_length>0.9</tendon_slack_length></RCNLMuscle>
+ </RCNLMuscleSet></OsimxModel></NMSMPipelineDocument>""")
+    with pytest.raises(InputError) as info:
+        prepare(write_settings(folder, tutorial, osimx=str(osimx)))
+    message = str(info.value)
+    assert "soleus_r" in message and "gait_1" in message and "0.9" in message and "long.osimx" in message
+
+
+def test_tiny_tendon_slack_length_gives_finite_results(case):
+    """l_ts near zero (the original blew up): guarded maths; results finite or a clear error."""
+    folder, tutorial = case
+    osimx = folder / "tiny.osimx"
+    osimx.write_text("""<NMSMPipelineDocument Version="1.5.3"><OsimxModel name="m">
+ <associated_osim_model>m.osim</associated_osim_model><RCNLMuscleSet>
+ <RCNLMuscle name="tib_ant_r"><tendon_slack_length>1e-6</tendon_slack_length></RCNLMuscle>
+ </RCNLMuscleSet></OsimxModel></NMSMPipelineDocument>""")
+    settings = write_settings(folder, tutorial, osimx=str(osimx))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        outcome = run_settings(settings, max_iterations=30)
+    assert np.isfinite(outcome.tasks[0].cost)
+    for path in (folder / "results").rglob("*.sto"):
+        assert np.all(np.isfinite(read_storage(path).data)), path.name

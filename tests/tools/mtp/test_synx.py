@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import casadi as cs
 import numpy as np
 import pytest
@@ -44,6 +46,7 @@ def test_nmf_reconstructs_low_rank_data():
     assert np.linalg.norm(c @ w - c_true @ w_true) <= 1e-3 * np.linalg.norm(c_true @ w_true)
 
 
+@functools.lru_cache(maxsize=None)
 def _setup(method="PCA", residual="trial"):
     rng = np.random.default_rng(5)
     emg = [rng.random((21, 3)) for _ in range(2)]
@@ -80,3 +83,39 @@ def test_zero_channel_is_an_error():
     emg[0][:, 0] = 1.0
     with pytest.raises(InputError, match="zero in every trial"):
         synx.normalize_emg(emg)
+
+
+def test_nmf_extrapolation_weights_are_non_negative():
+    """NMF: extrapolated excitations are non-negative combinations of non-negative commands."""
+    _, s = _setup("NMF")
+    low, high = s.weight_bounds(-100.0, 100.0)
+    assert low.shape == high.shape == (s.n_weights,)
+    assert np.all(low[: s.n_extrapolation_weights] == 0.0)
+    assert np.all(low[s.n_extrapolation_weights :] == -100.0)  # residuals stay signed
+    _, p = _setup("PCA")
+    assert np.all(p.weight_bounds()[0] == -100.0)
+
+
+@pytest.mark.parametrize("method", ["PCA", "NMF"])
+def test_extrapolated_excitation_constraint_in_problem(method):
+    """Both methods bound the extrapolated excitations to [0, 1] inside the MTP problem."""
+    from nmsm.examples.synthetic_mtp import make_synthetic_mtp
+    from nmsm.tools.mtp.evaluation import initial_fiber_lengths
+    from nmsm.tools.mtp.problem import MtpState, TaskSettings, build_task_problem
+    import attrs
+
+    case = make_synthetic_mtp(n_muscles=3, n_trials=2, seed=3)
+    data = case.data
+    emg = [t.emg[:, :2] for t in data.trials]  # muscle 2 has no EMG
+    sx = synx.build_synergy_extrapolation(
+        emg, [t.name for t in data.trials], method=method, n_synergies=1, extrapolation_categorization="subject",
+        residual_categorization="trial", missing_muscles=[(2,)], channel_muscles=[(0,), (1,)])
+    data = attrs.evolve(data, channel_of_muscle=np.array([0, 1, -1]), synx=sx,
+                        trials=tuple(attrs.evolve(t, emg=t.emg[:, :2]) for t in data.trials))
+    problem, _ = build_task_problem(data, MtpState.initial(data), TaskSettings(), initial_fiber_lengths(data),
+                                    lift=False)
+    names = [c.name for c in problem.constraints]
+    assert "extrapolated_excitation_0_1" in names
+    block = problem.variables["synergy_weights"]
+    lower = np.asarray(block.lower).ravel()
+    assert lower[: sx.n_extrapolation_weights].min() == (0.0 if method == "NMF" else -100.0)
