@@ -14,6 +14,12 @@ scale with it on a shared machine). Prints the per-coordinate moment RMS.
 activations free in [0, 1], fitted to the ID moments by bounded linear least squares
 (the muscle model is linear in activation), a lower bound for any synergy solution.
 
+``--free-bound`` also prints the best any activations can do *at the settings' weights*:
+each frame's activations free in [0, 1] minimizing the settings' moment-tracking,
+activation-tracking and activation-minimization terms (grouped terms left out). Synergies only restrict that set,
+so this is where the settings' weights put the trade-off before any synergy constraint.
+It also prints the moment RMS of the MTP activations themselves (other muscles at 0).
+
 ``--sweep`` also runs the activation-tracking allowable error 0.01 / 0.02 / 0.03 / 0.05
 with and without bilateral symmetry (settings rewritten into the temporary folder) and
 prints the moment-RMS / activation-RMS trade-off.
@@ -70,6 +76,57 @@ def free_activation_moment_rms(run) -> np.ndarray:
     return np.sqrt(squared / frames)
 
 
+def _term(run, kind: str):
+    """The enabled term of ``kind`` in the run's settings."""
+    for term in run.setup.terms:
+        if getattr(term, "type", None) == kind:
+            return term
+    raise LookupError(f"no enabled '{kind}' term in the settings")
+
+
+def settings_weight_bound(run) -> tuple[np.ndarray, float]:
+    """Per-coordinate moment RMS (J,) N·m and pooled activation RMS of each frame's
+    activations free in [0, 1] minimizing the settings' moment-tracking, activation-tracking
+    and activation-minimization terms (each term ``mean((raw / e)**2)`` as in the cost)."""
+    inputs = run.setup.inputs
+    e_moment = _term(run, "moment_tracking").max_allowable_error
+    e_tracking = _term(run, "activation_tracking").max_allowable_error
+    minimization = _term(run, "activation_minimization")
+    e_minimum, center = minimization.max_allowable_error, minimization.error_center
+    tracked = list(inputs.mtp_indices)
+    untracked = [i for i in range(inputs.layout.n_muscles) if i not in set(tracked)]
+    n_muscles, n_loads = inputs.layout.n_muscles, len(inputs.coordinates)
+    select = np.eye(n_muscles)
+    rows_tracked = select[tracked] / (e_tracking * np.sqrt(len(tracked)))
+    rows_untracked = select[untracked] / (e_minimum * np.sqrt(max(len(untracked), 1)))
+    moment_scale = 1.0 / (e_moment * np.sqrt(n_loads))
+    moment_errors, activation_errors = [], []
+    for trial in inputs.trials:
+        gains = moment_gains(trial, inputs.muscles, inputs.v_max_factor)
+        for p in range(trial.n_points):
+            target = trial.moments[p] - gains.passive[p]
+            system = np.vstack([gains.active[p] * moment_scale, rows_tracked, rows_untracked])
+            rhs = np.concatenate([target * moment_scale, rows_tracked[:, tracked] @ trial.mtp_activations[p],
+                                  rows_untracked[:, untracked] @ np.full(len(untracked), center)])
+            x = lsq_linear(system, rhs, bounds=(0.0, 1.0)).x
+            moment_errors.append(gains.active[p] @ x - target)
+            activation_errors.append(x[tracked] - trial.mtp_activations[p])
+    moment_rms = np.sqrt(np.mean(np.square(moment_errors), axis=0))
+    return moment_rms, float(np.sqrt(np.mean(np.square(activation_errors))))
+
+
+def mtp_activation_moment_rms(run) -> np.ndarray:
+    """Per-coordinate moment RMS (J,) N·m of the MTP activations as they are, other muscles at 0."""
+    inputs = run.setup.inputs
+    tracked = list(inputs.mtp_indices)
+    errors = []
+    for trial in inputs.trials:
+        activations = np.zeros((trial.n_points, inputs.layout.n_muscles))
+        activations[:, tracked] = trial.mtp_activations
+        errors.append(moment_gains(trial, inputs.muscles, inputs.v_max_factor).moments(activations) - trial.moments)
+    return np.sqrt(np.mean(np.square(np.vstack(errors)), axis=0))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=3)
@@ -102,6 +159,12 @@ def main() -> None:
             free = free_activation_moment_rms(run)
             print(f"free activations in [0, 1] (no synergies): mean moment RMS {free.mean():.4f} N·m, "
                   f"largest {free.max():.4f} N·m")
+            mtp = mtp_activation_moment_rms(run)
+            print(f"MTP activations as they are (other muscles 0): mean moment RMS {mtp.mean():.2f} N·m, largest "
+                  f"{mtp.max():.2f} N·m ({m.coordinates[int(np.argmax(mtp))]})")
+            bound, activation = settings_weight_bound(run)
+            print(f"free activations at the settings' weights (no synergies): mean moment RMS {bound.mean():.2f} N·m, "
+                  f"activation RMS {activation:.4f}")
         if args.sweep:
             print("\n| activation e | symmetry | iterations | wall s | cost | mean moment RMS N·m | activation RMS |")
             print("|---|---|---|---|---|---|---|")
