@@ -24,6 +24,7 @@ excitations are bounded to [0, 1] (linear).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -162,6 +163,22 @@ def fiber_length_constraints(models: Sequence[TrialModel]) -> tuple[cs.MX, cs.MX
     return cs.vertcat(*upper), cs.vertcat(*lower)
 
 
+def _warn_fixed_lengths_outside(models: Sequence[TrialModel], muscles: Sequence[str], name: str) -> None:
+    """Warn, naming the muscles, when fixed optimal fiber and tendon slack lengths put a
+    normalized fiber length outside [0.3, 1.3] (the limits are then left out of the task)."""
+    stacked = np.vstack([np.asarray(cs.evalf(m.normalized_fiber_length)) for m in models])
+    low, high = stacked.min(axis=0), stacked.max(axis=0)
+    outside = [f"{muscles[i]} ({low[i]:.2f}..{high[i]:.2f})" for i in range(len(muscles))
+               if low[i] < CONSTRAINT_MIN_LENGTH or high[i] > CONSTRAINT_MAX_LENGTH]
+    if outside:
+        warnings.warn(
+            f"{name}: optimal fiber and tendon slack lengths are not optimized in this task and put "
+            f"normalized fiber lengths outside [{CONSTRAINT_MIN_LENGTH}, {CONSTRAINT_MAX_LENGTH}]: "
+            + ", ".join(outside) + "; the limits apply from the first task that optimizes those lengths",
+            stacklevel=3,
+        )
+
+
 def build_task_problem(
     data: MtpData,
     state: MtpState,
@@ -230,7 +247,13 @@ def build_task_problem(
     if data.synx is not None:
         for term in task.synx_terms:
             problem.add_term(term, ctx)
-    if fiber_length_limits == "softmax":
+    lengths_fixed = not (task.optimize.get("optimal_fiber_length_scale", True)
+                         or task.optimize.get("tendon_slack_length_scale", True))
+    if lengths_fixed:
+        # the limits depend on l_o and l_ts only: with both fixed they are constants that no
+        # design variable can change (IPOPT would only report an infeasible problem)
+        _warn_fixed_lengths_outside(plain, data.muscles.names, name)
+    elif fiber_length_limits == "softmax":
         upper, lower = fiber_length_constraints(plain)
         problem.add_constraint("normalized_fiber_length_max_1.3", upper, -np.inf, 0.0)
         problem.add_constraint("normalized_fiber_length_min_0.3", lower, -np.inf, 0.0)
