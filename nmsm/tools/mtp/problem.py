@@ -201,7 +201,9 @@ def build_task_problem(
     ``fiber_length_limits``: ``"frames"`` bounds every normalized fiber length to
     [0.3, 1.3] (smooth, well conditioned); ``"softmax"`` is the original's per-muscle soft
     maximum with sharpness 500 (stricter by at most ``log(n_trials n_frames) / 500``), whose
-    gradients grow 500-fold near the limit and stall IPOPT on patient data.
+    gradients grow 500-fold near the limit and stall IPOPT on patient data. A task that
+    optimizes neither l_o nor l_ts gets no limits (they would be constants): it warns,
+    naming the muscles, when those constants are outside [0.3, 1.3].
     """
     problem = OptimizationProblem(name)
     m = data.muscles.n_muscles

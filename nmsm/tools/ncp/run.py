@@ -71,8 +71,8 @@ def read_settings(path: str | os.PathLike[str]) -> NeuralControlPersonalizationS
 
 
 #: IPOPT's acceptable-level stop: the objective unchanged to this relative amount over
-#: ``acceptable_iter`` iterations with the scaled NLP error below ``acceptable_tol``. When
-#: there are fewer muscles per synergy than the data need, equal-cost factorizations form
+#: ``acceptable_iter`` iterations with the scaled NLP error below ``acceptable_tol``. When a
+#: group has more synergies than its activations need, equal-cost factorizations form
 #: flat directions, and IPOPT's dual infeasibility then wanders (1e-7..1e-4) at a constant
 #: objective instead of reaching ``tol`` (the example: 1000 iterations, cost constant to
 #: 8 digits from iteration ~100; with this stop 90 iterations, the same cost to 1e-10).
