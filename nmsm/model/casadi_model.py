@@ -124,13 +124,13 @@ class CasadiModel:
 
     # ------------------------------------------------------------------ kinematics
     def body_pose_function(self, body: str) -> cs.Function:
-        """``(q[, p]) -> (R 3x3 body->ground, origin 3x1 m)`` of ``body``."""
+        """``(q[, p]) -> (R 3x3 body->ground, origin 3x1 m)`` (outputs "R", "origin") of ``body``."""
         self._check_body(body)
 
         def build() -> cs.Function:
             st = self._position_states()[body] if body != GROUND else BodyState(cs.DM.eye(3), cs.DM.zeros(3, 1))
             return cs.Function(f"pose_{body}", self._inputs(self.q), [st.R, st.p],
-                               self._input_names("q"), ["R", "p"])
+                               self._input_names("q"), ["R", "origin"])
 
         return self._function(("pose", body), build)
 
@@ -169,7 +169,7 @@ class CasadiModel:
             r_local, p_local = self.kinematics.frame_in_base(frame_path)
             return cs.Function("frame_pose", self._inputs(self.q),
                                [cs.mtimes(st.R, r_local), st.p + cs.mtimes(st.R, p_local)],
-                               self._input_names("q"), ["R", "p"])
+                               self._input_names("q"), ["R", "origin"])
 
         return self._function(("frame", frame_path), build)
 

@@ -214,7 +214,7 @@ class GridView:
 
         def compute(view: GridView) -> list[cs.MX]:
             f = self._q.cache(("whole_body_function",), lambda: whole_body_function(self._q.data.model))
-            return view.map_kinematics_function("whole_body", f, "q, qd")
+            return view.map_kinematics_function("whole_body", f, "q, qd", extra=tuple(self._q.model_parameter_row()))
         return self.cached("whole_body", compute)
 
     def center_of_mass_position(self) -> cs.MX:
@@ -615,6 +615,29 @@ class _Quantities:
             self._cache[key] = compute()
         return self._cache[key]
 
+    # ---- model parameters (Design Optimization joint-frame model functions) ----------------------
+    def _parameter_count(self) -> int:
+        return int(getattr(self.data.model, "parameter_count", 0))
+
+    def model_parameter_symbols(self) -> list[cs.SX]:
+        """``[p]`` (SX, (n_p, 1)) for building point functions of a parametric model, else []."""
+        n = self._parameter_count()
+        return [cs.SX.sym("p_model", n)] if n else []
+
+    def model_parameter_row(self) -> list[cs.MX]:
+        """``[p]`` (MX, (1, n_p)): the model parameters' values for :meth:`map_point`, else []."""
+        if not self._parameter_count():
+            return []
+        return [cs.reshape(self.data.model_parameter_values, 1, self._parameter_count())]
+
+    def model_parameter_initial(self, n_rows: int) -> list[cs.DM]:
+        """``[P]`` (DM, (n_p, n_rows)): the file's parameter values, for numeric evaluation of
+        tracked quantities (the tracked data belong to the file's model), else []."""
+        if not self._parameter_count():
+            return []
+        initial = cs.DM(self.data.model.parameters.initial_values).reshape((-1, 1))
+        return [cs.repmat(initial, 1, n_rows)]
+
     # ---- indices ---------------------------------------------------------------------------
     def coordinate_index(self, name: str) -> int:
         try:
@@ -767,7 +790,7 @@ class _Quantities:
             contacts = self.data.contact_models
             if not contacts:
                 f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
-                (tau,) = self.map_point(f, grid)
+                (tau,) = self.map_point(f, grid, *self.model_parameter_row())
                 return tau
             f = self.composed("inverse_dynamics_contact", self._contact_inverse_dynamics_function())
             (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts])
@@ -875,15 +898,16 @@ class _Quantities:
             nq = len(self.data.model.coordinate_names)
             q = cs.SX.sym("q", nq)
             qd = cs.SX.sym("qd", nq)
-            p = f(q)
+            parameters = self.model_parameter_symbols()
+            p = f(q, *parameters)
             v = cs.jtimes(p, q, qd)
-            return cs.Function(f"marker_{marker}", [q, qd], [p, v])
+            return cs.Function(f"marker_{marker}", [q, qd, *parameters], [p, v])
         return self.cache(("marker_function", marker), compute)
 
     def marker(self, grid: str, marker: str) -> tuple[cs.MX, cs.MX]:
         def compute() -> tuple[cs.MX, cs.MX]:
             f = self.composed(("marker", marker), self._marker_functions(marker), "q, qd")
-            p, v = self.map_point(f, grid)
+            p, v = self.map_point(f, grid, *self.model_parameter_row())
             return p, v
         return self.cache((grid, "marker", marker), compute)
 
@@ -891,7 +915,7 @@ class _Quantities:
         def compute() -> tuple[cs.DM, cs.DM]:
             q, qd, _ = self.data.tracked_full_kinematics(self.reference_times(grid))
             f = self._marker_functions(marker).map(q.shape[0])
-            p, v = f(cs.DM(q).T, cs.DM(qd).T)
+            p, v = f(cs.DM(q).T, cs.DM(qd).T, *self.model_parameter_initial(q.shape[0]))
             return cs.DM(p).T, cs.DM(v).T
         return self.cache((grid, "tracked_marker", marker), compute)
 
@@ -899,14 +923,16 @@ class _Quantities:
         def compute() -> cs.Function:
             nq = len(self.data.model.coordinate_names)
             q = cs.SX.sym("q", nq)
-            R = self.data.model.body_rotation_function(body)(q)
-            return cs.Function(f"orientation_{body}_{sequence}", [q], [cs.vertcat(*euler_angles(R, sequence))])
+            parameters = self.model_parameter_symbols()
+            R = self.data.model.body_rotation_function(body)(q, *parameters)
+            return cs.Function(f"orientation_{body}_{sequence}", [q, *parameters],
+                               [cs.vertcat(*euler_angles(R, sequence))])
         return self.cache(("orientation_function", body, sequence), compute)
 
     def orientation(self, grid: str, body: str, sequence: str) -> cs.MX:
         def compute() -> cs.MX:
             f = self.composed(("orientation", body, sequence), self._orientation_function(body, sequence), "q")
-            (angles,) = self.map_point(f, grid)
+            (angles,) = self.map_point(f, grid, *self.model_parameter_row())
             return angles
         return self.cache((grid, "orientation", body, sequence), compute)
 
@@ -914,7 +940,7 @@ class _Quantities:
         def compute() -> cs.DM:
             q, _, _ = self.data.tracked_full_kinematics(self.reference_times(grid))
             f = self._orientation_function(body, sequence).map(q.shape[0])
-            return cs.DM(f(cs.DM(q).T)).T
+            return cs.DM(f(cs.DM(q).T, *self.model_parameter_initial(q.shape[0]))).T
         return self.cache((grid, "tracked_orientation", body, sequence), compute)
 
     # ---- controls -----------------------------------------------------------------------------

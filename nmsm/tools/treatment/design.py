@@ -88,4 +88,21 @@ def write_parameter_solution(stage: Path, prepared: Any, tsol: Any) -> list[Path
         etree.SubElement(entry, "values").text = " ".join(repr(float(x)) for x in v)
     path = stage / f"{tsol.trial_name}_parameterSolution.xml"
     path.write_bytes(etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="UTF-8"))
-    return [path]
+    return [path, *write_design_model(stage, prepared, tsol)]
+
+
+def write_design_model(stage: Path, prepared: Any, tsol: Any) -> list[Path]:
+    """``<model>DesignOpt.osim`` (spec §11.1): the input model with the solution's joint-frame
+    parameters written in place (the rest of the file untouched), when model functions made
+    the model parametric (:mod:`nmsm.modifiers.joint_frame`)."""
+    from nmsm.model.osim_writer import OsimWriter
+
+    data = prepared.data
+    model = data.model
+    if not getattr(model, "parameter_count", 0) or data.model_parameter_values is None:
+        return []
+    values = np.asarray(tsol.value(data.model_parameter_values), dtype=float).ravel()
+    source = Path(model.file)
+    writer = OsimWriter(source)
+    writer.apply_parameters(model.parameters, values)
+    return [writer.write(stage / f"{source.stem}DesignOpt.osim")]

@@ -3,6 +3,10 @@
 Inverse dynamics is OpenSim's ID tool's: all muscles disabled, gravity on, no external
 loads except those of the problem's contact models (``load_bodies``). Speeds are OpenSim
 generalized speeds (coordinate rates for the joints the tutorials use).
+
+With :class:`~nmsm.model.parameters.ModelParameters` (Design Optimization's joint-frame
+model functions, :mod:`nmsm.modifiers.joint_frame`) every function below takes the model
+parameters ``p`` (``parameter_count``,) as its last input.
 """
 
 from __future__ import annotations
@@ -13,15 +17,29 @@ from functools import cached_property
 import casadi as cs
 
 from nmsm.model import CasadiModel, Model, load_model
+from nmsm.model.parameters import ModelParameters
 
 
 class OsimTreatmentModel:
-    """Adapter: per-point CasADi functions of an ``.osim`` model."""
+    """Adapter: per-point CasADi functions of an ``.osim`` model (``parameters``: see the
+    module docstring)."""
 
-    def __init__(self, model: Model | str | os.PathLike[str]) -> None:
+    def __init__(self, model: Model | str | os.PathLike[str], parameters: ModelParameters | None = None) -> None:
         self.model = model if isinstance(model, Model) else load_model(model)
-        self.casadi = CasadiModel(self.model)
+        self.casadi = CasadiModel(self.model, parameters)
         self._rotational = {c.name: c.is_rotational for c in self.model.coordinates}
+
+    @property
+    def parameters(self) -> ModelParameters:
+        return self.casadi.parameters
+
+    @property
+    def parameter_count(self) -> int:
+        """Number of model parameters (0 for the file's model)."""
+        return int(self.casadi.parameters.size)
+
+    def _parameter_inputs(self) -> list[cs.SX]:
+        return [self.casadi.p] if self.casadi.has_parameters else []
 
     @property
     def file(self) -> str:
@@ -62,10 +80,10 @@ class OsimTreatmentModel:
 
     def body_rotation_function(self, body: str) -> cs.Function:
         pose = self.casadi.body_pose_function(body)
-        q = cs.SX.sym("q", len(self.coordinate_names))
-        return cs.Function(f"rotation_{body}", [q], [pose(q)[0]])
+        inputs = [cs.SX.sym("q", len(self.coordinate_names)), *self._parameter_inputs()]
+        return cs.Function(f"rotation_{body}", inputs, [pose(*inputs)[0]])
 
     def body_origin_function(self, body: str) -> cs.Function:
         pose = self.casadi.body_pose_function(body)
-        q = cs.SX.sym("q", len(self.coordinate_names))
-        return cs.Function(f"origin_{body}", [q], [pose(q)[1]])
+        inputs = [cs.SX.sym("q", len(self.coordinate_names)), *self._parameter_inputs()]
+        return cs.Function(f"origin_{body}", inputs, [pose(*inputs)[1]])

@@ -14,14 +14,21 @@ exact derivatives through them:
 ``target.scale_synergy_activation(name, factor)``   activation used by the muscles =
                                              control × factor (the control itself is unchanged)
 ``target.contact_models``                    contact model plugins (belt speed etc.)
+``target.set_joint_frame(joint, frame, quantity, axes, values)``   a joint's parent or child
+                                             offset frame's translation (m) or X-Y-Z orientation
+                                             (rad) components := values (torque-driven
+                                             problems without contact models)
 ``target.error(message, element=...)``       InputError at the settings file
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
-from nmsm.errors import InputError
+import casadi as cs
+
+from nmsm.errors import InputError, ModelError
 
 
 class ModificationTarget:
@@ -92,3 +99,44 @@ class ModificationTarget:
     @property
     def contact_models(self) -> list[Any]:
         return list(getattr(self.data, "contact_models", []))
+
+    # ---- joint frames -------------------------------------------------------------------------
+    def set_joint_frame(self, joint: str, frame: str, quantity: str, axes: Sequence[int], values: Any) -> None:
+        """Make components ``axes`` (0 = x, 1 = y, 2 = z) of ``joint``'s ``frame`` ('parent' or
+        'child') offset ``quantity`` ('translation' m, 'orientation' rad, body-fixed X-Y-Z)
+        equal to ``values`` (MX, one per axis). Every kinematic quantity of the problem
+        (inverse dynamics, markers, orientations, whole-body terms) then follows the moved
+        frame; tracked data keep the file's model."""
+        from nmsm.model.parameters import ModelParameters
+        from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
+
+        model = self.data.model
+        if not isinstance(model, OsimTreatmentModel):
+            raise self.error("joint-frame model functions need an .osim model", element="<input_model_file>")
+        if self.data.contact_models:
+            raise self.error("joint-frame model functions are not supported with contact models (their "
+                             "spring and sphere locations would not follow the frame)",
+                             element="<model_functions>", expected="a problem without contact surfaces")
+        if self._muscle_models():
+            raise self.error("joint-frame model functions are not supported with muscle-driven controllers "
+                             "(the surrogate and path muscle geometry is the file's)",
+                             element="<model_functions>", expected="torque-driven controllers only")
+        if frame not in ("parent", "child") or quantity not in ("translation", "orientation"):
+            raise self.error(f"joint frame '{frame}' {quantity}", element="<RCNLParameterTerm>",
+                             expected="frame parent|child and quantity translation|orientation")
+        values = cs.MX(values).reshape((-1, 1)) if not isinstance(values, cs.MX) else cs.reshape(values, -1, 1)
+        if values.numel() != len(axes):
+            raise self.error(f"{values.numel()} values for {len(axes)} axes of joint '{joint}'",
+                             element="<initial_values>", expected=f"{len(axes)} values")
+        parameters = model.parameters if model.parameter_count else ModelParameters(model.model)
+        register = parameters.joint_frame_translation if quantity == "translation" else parameters.joint_frame_orientation
+        try:
+            register(joint, frame, components=tuple(axes))
+        except (ModelError, KeyError) as exc:
+            raise self.error(str(exc), element="<joint>", expected="a joint of the model with a "
+                             f"{frame} offset frame") from None
+        except ValueError as exc:  # the same components twice
+            raise self.error(str(exc), element="<model_functions>") from None
+        previous = self.data.model_parameter_values
+        self.data.model_parameter_values = values if previous is None else cs.vertcat(previous, values)
+        self.data.model = OsimTreatmentModel(model.model, parameters)

@@ -41,6 +41,9 @@ class TreatmentData:
     controllers: list[Any] = attrs.field(factory=list)
     contact_models: list[Any] = attrs.field(factory=list)
     parameters: dict[str, cs.MX] = attrs.field(factory=dict)
+    #: (n_p, 1) values of the model's parameters (``model.parameter_count`` > 0: joint-frame
+    #: model functions of Design Optimization), expressions of ``parameters``; None otherwise
+    model_parameter_values: cs.MX | None = None
     acceleration_control_offset: int = 0
     #: free final time: scale prescribed coordinates' speeds by T_ref/t_f and accelerations by
     #: (T_ref/t_f)^2 (physically consistent time warping). False reproduces the original,

@@ -66,7 +66,8 @@ def _body_terms(model: Any, q: cs.SX, qd: cs.SX) -> list[tuple[Any, cs.SX, cs.SX
 
 
 def whole_body_function(model: Any) -> cs.Function:
-    """SX ``(q, qd) -> (com, com_velocity, angular_momentum)`` (see module docstring)."""
+    """SX ``(q, qd[, p]) -> (com, com_velocity, angular_momentum)`` (see module docstring);
+    ``p``: the model parameters of a parametric ``.osim`` adapter."""
     if not supports_whole_body(model):
         raise TypeError(f"{type(model).__name__} has no mass properties (needs an OpenSim model or "
                         "mass_properties(body))")
@@ -81,7 +82,9 @@ def whole_body_function(model: Any) -> cs.Function:
     H = cs.SX.zeros(3, 1)
     for mass, c, v, I_g, w in bodies:
         H = H + mass * cs.cross(c - com, v - vcom) + cs.mtimes(I_g, w)
-    return cs.Function("whole_body", [q, qd], [com, vcom, H], ["q", "qd"], ["com", "com_velocity", "angular_momentum"])
+    parameters = [model.casadi.p] if _has_tree(model) and model.casadi.has_parameters else []
+    return cs.Function("whole_body", [q, qd, *parameters], [com, vcom, H], ["q", "qd", *(["p"] if parameters else [])],
+                       ["com", "com_velocity", "angular_momentum"])
 
 
 def foot_reaction_function(contact_function: cs.Function, name: str = "foot", *,

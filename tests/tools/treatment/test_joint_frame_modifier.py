@@ -1,0 +1,208 @@
+"""Joint-frame model functions (DO): a joint's frame as a design parameter.
+
+Known answer: the toy arm's elbow moments are generated with its parent frame turned by
+TRUE_ANGLE about the elbow axis; a Design Optimization of the file's arm (angle 0) that tracks
+the elbow angle and those moments recovers the angle. The context's inverse dynamics, markers
+and orientations follow the parameter exactly (compared with the parametric model core).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import casadi as cs
+import numpy as np
+import pytest
+
+from nmsm.controllers.torque import TorqueController
+from nmsm.errors import InputError
+from nmsm.model import CasadiModel, load_model
+from nmsm.model.parameters import ModelParameters
+from nmsm.modifiers.joint_frame import ApplyJointFrameOrientationParameter, ApplyJointFrameTranslationParameter
+from nmsm.terms.treatment.inverse_dynamics import InverseDynamicsLoadTracking
+from nmsm.terms.treatment.kinematics import GeneralizedCoordinateTracking
+from nmsm.tools.treatment.bounds import RangeRule, range_bounds
+from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.tools.treatment.formulation import StateSetup, build_problem
+from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
+from nmsm.tools.treatment.modifiers import ModificationTarget
+from nmsm.tools.treatment.problem_data import TreatmentData
+from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.tools.treatment.transcription.mesh import Mesh
+
+DURATION = 1.0
+TRUE_ANGLE = 0.12  # rad, elbow parent frame about its z axis (the flexion axis)
+PARAMETER = "joint_frame_orientation_elbow"
+COORDINATE = "r_elbow_flex"
+
+
+@pytest.fixture(scope="module")
+def arm(shared_data):
+    return load_model(shared_data / "jmp" / "toy_simple_arm" / "simple_arm.osim")
+
+
+def _file_angle(model) -> float:
+    """The file's elbow parent-frame z orientation (rad): parameter values are absolute."""
+    params = ModelParameters(model)
+    params.joint_frame_orientation("r_elbow", "parent", components=(2,))
+    return float(params.initial_values[0])
+
+
+def _references(model) -> tuple[ReferenceSplines, ReferenceSplines]:
+    """Elbow motion and its inverse dynamics with the frame turned by TRUE_ANGLE."""
+    t = np.linspace(0.0, DURATION, 61)
+    q = 1.0 + 0.5 * np.sin(2 * np.pi * t)
+    qd = 0.5 * 2 * np.pi * np.cos(2 * np.pi * t)
+    qdd = -0.5 * (2 * np.pi) ** 2 * np.sin(2 * np.pi * t)
+    params = ModelParameters(model)
+    params.joint_frame_orientation("r_elbow", "parent", components=(2,))
+    truth = np.array(params.initial_values)
+    truth[0] += TRUE_ANGLE
+    inverse = CasadiModel(model, params).inverse_dynamics_function()
+    tau = np.array([float(inverse(q[k], qd[k], qdd[k], truth)) for k in range(t.size)])
+    coords = ReferenceSplines(t, (COORDINATE,), q[:, None])
+    loads = ReferenceSplines(t, (f"{COORDINATE}_moment",), tau[:, None])
+    return coords, loads
+
+
+def _settings(axes: str = "z", joint: str = "r_elbow") -> SimpleNamespace:
+    term = SimpleNamespace(type=PARAMETER, fields={"joint": joint, "frame": "parent", "axes": axes})
+    return SimpleNamespace(parameter_terms=[term], settings_file="design.xml")
+
+
+def _build(model, terms, *, start: float = 0.0, settings: SimpleNamespace | None = None):
+    adapter = OsimTreatmentModel(model)
+    coords, loads = _references(model)
+    refs = {"coordinates": coords, "loads": loads}
+    mesh = Mesh.uniform(5, 5)
+    s_col = mesh.times("collocation")
+    setup = ControllerSetup("DO", adapter, s_col * DURATION, DURATION, refs, {"loads": loads})
+    data = TreatmentData("DO", adapter, (COORDINATE,), refs, coords, DURATION, DURATION, (DURATION, DURATION))
+    data.controllers = [TorqueController.from_settings({"coordinate_list": COORDINATE}, setup)]
+    t = coords.time
+    lo_q, hi_q = range_bounds(coords.values(t, 0, (COORDINATE,)), RangeRule(2))
+    lo_v, hi_v = range_bounds(coords.values(t, 1, (COORDINATE,)), RangeRule(1.5))
+    lo_a, hi_a = range_bounds(coords.values(t, 2, (COORDINATE,)), RangeRule(1))
+    tn = mesh.times("nodes") * DURATION
+    guess = np.hstack([coords.values(tn, 0, (COORDINATE,)), coords.values(tn, 1, (COORDINATE,))])
+    states = StateSetup(np.r_[lo_q, lo_v], np.r_[hi_q, hi_v], lo_a, hi_a, guess,
+                        coords.values(s_col * DURATION, 2, (COORDINATE,)))
+    chosen = settings or _settings()
+
+    def declare(problem, data):
+        data.parameters[PARAMETER] = problem.variable("parameter:" + PARAMETER, np.array([start]),
+                                                      np.array([start - 0.3]), np.array([start + 0.3]))
+        modifier = ApplyJointFrameOrientationParameter("applyJointFrameOrientationParameter", "design.xml")
+        modifier.apply(ModificationTarget(data, chosen), data.parameters)
+
+    return build_problem(data, mesh, states, list(terms), declare_extra=declare)
+
+
+def _at_guess(built, expression):
+    problem = built.problem
+    x0 = np.clip(problem.initial_scaled(), *problem.bounds_scaled())
+    return np.asarray(problem.evaluate(cs.MX(expression), x0))
+
+
+def test_context_follows_the_parameter(arm) -> None:
+    """ID, a marker, the centre of mass and the forearm's orientation at the guess (parameter
+    0.2 rad) follow the parametric model core at the same value; the tracked marker stays the
+    file's."""
+    built = _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], start=_file_angle(arm) + 0.2)
+    assert built.context._q.data.model.parameter_count == 1
+    view = built.context.at("nodes")
+    q = _at_guess(built, view.positions())
+    qd = _at_guess(built, view.speeds())
+    qdd = _at_guess(built, view.accelerations())
+    core = built.context._q.data.model.casadi
+    p = np.array([_file_angle(arm) + 0.2])
+    tau = _at_guess(built, view.inverse_dynamics())
+    expected = np.array([np.asarray(core.inverse_dynamics_function()(q[k], qd[k], qdd[k], p)).ravel()
+                         for k in range(q.shape[0])])
+    np.testing.assert_allclose(tau, expected, atol=1e-10)
+    marker = arm.marker_names[-1]
+    position = _at_guess(built, view.marker_position(marker))
+    expected = np.array([np.asarray(core.marker_function([marker])(q[k], p)).ravel() for k in range(q.shape[0])])
+    np.testing.assert_allclose(position, expected, atol=1e-12)
+    file_model = CasadiModel(arm)
+    tracked = np.asarray(built.context._q.tracked_marker("nodes", marker)[0])
+    q_tracked = built.context._q.data.tracked_full_kinematics(built.context._q.reference_times("nodes"))[0]
+    expected = np.array([np.asarray(file_model.marker_function([marker])(q_tracked[k])).ravel()
+                         for k in range(q_tracked.shape[0])])
+    np.testing.assert_allclose(tracked, expected, atol=1e-12)
+    com = _at_guess(built, view.center_of_mass_position())
+    expected = np.array([np.asarray(core.center_of_mass_function()(q[k], p)).ravel() for k in range(q.shape[0])])
+    np.testing.assert_allclose(com, expected, atol=1e-12)
+    from nmsm.tools.treatment.orientation import euler_angles
+
+    turned = _at_guess(built, view.body_orientation("r_ulna_radius_hand", "xyz"))
+    pose = core.body_pose_function("r_ulna_radius_hand")
+    expected = np.array([[float(x) for x in euler_angles(pose(q[k], p)[0], "xyz")] for k in range(q.shape[0])])
+    np.testing.assert_allclose(turned, expected, atol=1e-12)
+    plain = OsimTreatmentModel(arm).body_rotation_function("r_ulna_radius_hand")
+    unturned = np.array([[float(x) for x in euler_angles(plain(q[k]), "xyz")] for k in range(q.shape[0])])
+    assert np.abs(turned - unturned).max() > 0.1  # the frame did turn
+
+
+def test_design_optimization_recovers_the_frame(arm) -> None:
+    terms = [GeneralizedCoordinateTracking(coordinate=COORDINATE, max_allowable_error=0.01),
+             InverseDynamicsLoadTracking(load=f"{COORDINATE}_moment", max_allowable_error=0.01)]
+    built = _build(arm, terms, start=_file_angle(arm))
+    solution = built.problem.solve("ipopt", print_level=0, tol=1e-10)
+    assert solution.success, solution.status
+    recovered = float(np.asarray(solution.values["parameter:" + PARAMETER]).ravel()[0])
+    truth = _file_angle(arm) + TRUE_ANGLE
+    print(f"recovered {recovered:.8f} rad (truth {truth}), {solution.iterations} iterations")
+    assert abs(recovered - truth) < 1e-4, recovered
+
+
+def test_bad_joint_frame_settings(arm) -> None:
+    with pytest.raises(InputError, match="no_such_joint"):
+        _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], settings=_settings(joint="no_such_joint"))
+    with pytest.raises(InputError, match="<axes>"):
+        _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], settings=_settings(axes="z w"))
+    with pytest.raises(InputError, match="1 values for 2 axes"):
+        _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], settings=_settings(axes="x z"))
+    assert ApplyJointFrameTranslationParameter.type == "applyJointFrameTranslationParameter"
+
+
+def test_settings_file_run_writes_the_designed_model(shared_data, tmp_path) -> None:
+    """The kicking tutorial's torque DO V1 (fastest toe) with the knee's parent frame free to
+    turn about z, from a settings file: the solution's angle is written to
+    ``<trial>_parameterSolution.xml`` and into ``KickingModelDesignOpt.osim``, whose only change
+    is that element."""
+    import re
+
+    from nmsm.tools.treatment.run import run_settings
+
+    root = shared_data / "treatment" / "torque_kick_tutorial"
+    folder = root / "CompletedSettingsFiles"
+    text = (folder / "TorqueDOSettingsV1.xml").read_text()
+    for tag in ("initial_guess_directory", "tracked_quantities_directory"):
+        text = re.sub(f"<{tag}>([^<]*)</{tag}>", lambda m, tag=tag: f"<{tag}>{folder / m.group(1)}</{tag}>", text)
+    text = re.sub(r"<input_model_file>[^<]*</input_model_file>",
+                  f"<input_model_file>{root / 'KickingModel.osim'}</input_model_file>", text)
+    text = re.sub(r"<optimal_control_solver_settings_file>[^<]*</optimal_control_solver_settings_file>",
+                  f"<optimal_control_solver_settings_file>{root / 'GpopsSettings.xml'}"
+                  "</optimal_control_solver_settings_file>", text)
+    start = 0.124616326794065  # the file's value
+    text = text.replace("<RCNLTorqueController>", f"""<model_functions>applyJointFrameOrientationParameter</model_functions>
+        <RCNLParameterTermSet><RCNLParameterTerm><type>joint_frame_orientation_knee</type>
+        <joint>knee_r</joint><frame>parent</frame><axes>z</axes><initial_values>{start}</initial_values>
+        <lower_bounds>{start - 0.1}</lower_bounds><upper_bounds>{start + 0.1}</upper_bounds>
+        </RCNLParameterTerm></RCNLParameterTermSet>
+        <RCNLTorqueController>""", 1)
+    settings = tmp_path / "DesignKnee.xml"
+    settings.write_text(text)
+    run = run_settings(settings, results_directory=tmp_path / "results", print_level=0)
+    assert run.solution.success, run.solution.status
+    angle = float(np.asarray(run.solution.values["parameter:joint_frame_orientation_knee"]).ravel()[0])
+    solution_file = (tmp_path / "results" / "drive_kick1_parameterSolution.xml").read_text()
+    assert repr(angle) in solution_file
+    written = load_model(tmp_path / "results" / "KickingModelDesignOpt.osim")
+    frame = written.frames[ModelParameters(written).joint_frame_path("knee_r", "parent")]
+    assert frame.orientation[2] == pytest.approx(angle, abs=1e-12)
+    before = (root / "KickingModel.osim").read_text().splitlines()
+    after = (tmp_path / "results" / "KickingModelDesignOpt.osim").read_text().splitlines()
+    changed = [k for k, (a, b) in enumerate(zip(before, after)) if a != b]
+    assert len(before) == len(after) and len(changed) == 1 and "<orientation>" in after[changed[0]]
