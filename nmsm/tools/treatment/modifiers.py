@@ -27,6 +27,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import casadi as cs
+import numpy as np
 
 from nmsm.errors import InputError, ModelError
 
@@ -124,7 +125,9 @@ class ModificationTarget:
         if frame not in ("parent", "child") or quantity not in ("translation", "orientation"):
             raise self.error(f"joint frame '{frame}' {quantity}", element="<RCNLParameterTerm>",
                              expected="frame parent|child and quantity translation|orientation")
-        values = cs.MX(values).reshape((-1, 1)) if not isinstance(values, cs.MX) else cs.reshape(values, -1, 1)
+        if not isinstance(values, cs.MX):
+            values = cs.MX(cs.DM(np.atleast_1d(np.asarray(values, dtype=float))))
+        values = cs.reshape(values, -1, 1)
         if values.numel() != len(axes):
             raise self.error(f"{values.numel()} values for {len(axes)} axes of joint '{joint}'",
                              element="<initial_values>", expected=f"{len(axes)} values")
