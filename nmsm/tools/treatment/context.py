@@ -792,6 +792,9 @@ class _Quantities:
                 f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
                 (tau,) = self.map_point(f, grid, *self.model_parameter_row())
                 return tau
+            if self._parameter_count():
+                raise ValueError("contact models do not follow the model's joint-frame parameters: "
+                                 "a parametric model cannot have contact models")
             f = self.composed("inverse_dynamics_contact", self._contact_inverse_dynamics_function())
             (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts])
             return tau
