@@ -20,9 +20,10 @@ Example: optimize where the elbow sits on the humerus (x and y in its parent fra
     </RCNLParameterTerm>
     <model_functions>applyJointFrameTranslationParameter</model_functions>
 
-Inverse dynamics, markers, body orientations and whole-body quantities follow the moved
-frame with exact derivatives (:meth:`~nmsm.tools.treatment.modifiers.ModificationTarget.set_joint_frame`);
-tracked data keep the file's model. Torque-driven problems without contact models only.
+Inverse dynamics, markers, body orientations, whole-body quantities and elastic-foundation
+contact follow the moved frame with exact derivatives (:meth:`~nmsm.tools.treatment.modifiers.ModificationTarget.set_joint_frame`);
+tracked data keep the file's model. Not with muscle-driven controllers (their geometry is the
+file's); GCP's elastic-foundation contact follows the frame.
 The original has no such built-in (tools.md §11.1 lists muscle and belt-speed parameters).
 """
 

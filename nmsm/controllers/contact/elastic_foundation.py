@@ -34,6 +34,8 @@ class ElasticFoundationContact(ContactModel):
         self.moment_labels = tuple(surface.moment_columns)
         self.point_labels = tuple(surface.electrical_center_columns)
         self.values: list[Any] = list(self.surface.parameters.vector())
+        #: (1, n_m) values of the model's joint-frame parameters (DO model functions), or None
+        self.model_parameter_row: Any = None
 
     @classmethod
     def discover(cls, setup: Any) -> list[ContactModel]:
@@ -48,28 +50,37 @@ class ElasticFoundationContact(ContactModel):
         """Replace one of ``CONTACT_PARAMETERS`` (e.g. ``belt_speed``) by a value or MX."""
         self.values[CONTACT_PARAMETERS.index(name)] = value
 
+    def bind_model_parameters(self, row: Any) -> None:
+        """Follow a parametric model: ``row`` (1, n_m) are its parameters' values (MX); they are
+        appended to :meth:`parameters` and the point function's ``p``."""
+        self.model_parameter_row = row
+
     def parameters(self) -> Any:
-        return cs.horzcat(*[cs.MX(v) for v in self.values])
+        row = cs.horzcat(*[cs.MX(v) for v in self.values])
+        return row if self.model_parameter_row is None else cs.horzcat(row, self.model_parameter_row)
 
     def point_function(self, model: Any) -> cs.Function:
+        """``(q, qd, p) -> (loads 9 x k, force, moment, point)``; ``p`` = the contact parameters
+        (``CONTACT_PARAMETERS``) followed, for a parametric model, by the model's parameters."""
         cm = model.casadi
         surface = self.surface
         q, qd = cs.SX.sym("q", cm.n), cs.SX.sym("qd", cm.n)
         p = cs.SX.sym("p", len(CONTACT_PARAMETERS))
+        geometry = [cm.p] if cm.has_parameters else []  # the model's parameters, when it has any
         positions, velocities = [], []
         for body, location in zip(surface.spring_bodies, surface.spring_locations):
             point = cs.DM(location)
-            positions.append(cm.point_function(body)(q, point))
-            velocities.append(cm.point_velocity_function(body)(q, qd, point))
+            positions.append(cm.point_function(body)(q, point, *geometry))
+            velocities.append(cm.point_velocity_function(body)(q, qd, point, *geometry))
         positions, velocities = cs.horzcat(*positions), cs.horzcat(*velocities)
-        marker = cm.marker_function([surface.midfoot_superior_marker])(q)
+        marker = cm.marker_function([surface.midfoot_superior_marker])(q, *geometry)
         reference = cs.vertcat(marker[0], 0, marker[2])
         force, moment, _ = contact_function(surface.n_springs)(positions, velocities, cs.DM(surface.spring_constants),
                                                                p, reference)
         forces = spring_forces(positions, velocities, cs.DM(surface.spring_constants), p)
         columns = []
         for body in surface.bodies:
-            _, origin = cm.body_pose_function(body)(q)
+            _, origin = cm.body_pose_function(body)(q, *geometry)
             total, torque = cs.SX.zeros(3, 1), cs.SX.zeros(3, 1)
             for j, spring_body in enumerate(surface.spring_bodies):
                 if spring_body == body:
@@ -77,7 +88,8 @@ class ElasticFoundationContact(ContactModel):
                     torque = torque + cs.cross(positions[:, j] - origin, forces[:, j])
             columns.append(cs.vertcat(total, origin, torque))
         point = cs.vertcat(marker[0], p[CONTACT_PARAMETERS.index("resting_spring_length")], marker[2])
-        return cs.Function(f"contact_{self.name}", [q, qd, p], [cs.horzcat(*columns), force, moment, point])
+        inputs = cs.vertcat(p, *geometry)
+        return cs.Function(f"contact_{self.name}", [q, qd, inputs], [cs.horzcat(*columns), force, moment, point])
 
     def spring_count(self) -> int:
         return int(np.size(self.surface.spring_constants))

@@ -792,11 +792,8 @@ class _Quantities:
                 f = self.composed("inverse_dynamics", self.data.model.inverse_dynamics_function())
                 (tau,) = self.map_point(f, grid, *self.model_parameter_row())
                 return tau
-            if self._parameter_count():
-                raise ValueError("contact models do not follow the model's joint-frame parameters: "
-                                 "a parametric model cannot have contact models")
             f = self.composed("inverse_dynamics_contact", self._contact_inverse_dynamics_function())
-            (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts])
+            (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts], *self.model_parameter_row())
             return tau
         return self.cache((grid, "inverse_dynamics"), compute)
 
@@ -817,8 +814,9 @@ class _Quantities:
                 p = cs.SX.sym("p", f.size1_in(2))
                 params.append(p)
                 loads.append(f(q, qd, p)[0])
-            tau = model.inverse_dynamics_function(bodies)(q, qd, qdd, cs.horzcat(*loads))
-            return cs.Function("inverse_dynamics_contact", [q, qd, qdd, *params], [tau])
+            geometry = self.model_parameter_symbols()
+            tau = model.inverse_dynamics_function(bodies)(q, qd, qdd, cs.horzcat(*loads), *geometry)
+            return cs.Function("inverse_dynamics_contact", [q, qd, qdd, *params, *geometry], [tau])
         return self.cache(("contact_inverse_dynamics_function",), compute)
 
     def ground_reaction(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
@@ -855,8 +853,13 @@ class _Quantities:
             centre = refs.values(t, 0, contact.point_labels)
             q, qd, _ = self.data.tracked_full_kinematics(t)
             f = self._contact_function(contact)
-            # the reference point's x and z do not depend on the contact parameters
-            rows = f.map(q.shape[0])(q.T, qd.T, cs.DM.zeros(f.size1_in(2), q.shape[0]))
+            # the reference point's x and z do not depend on the contact parameters; a
+            # parametric model's parameters (last entries of p) take the file's values
+            n_model = self._parameter_count()
+            p = cs.DM.zeros(f.size1_in(2), q.shape[0])
+            if n_model:
+                p[f.size1_in(2) - n_model:, :] = self.model_parameter_initial(q.shape[0])[0]
+            rows = f.map(q.shape[0])(q.T, qd.T, p)
             point = np.asarray(rows[3]).T
             reference = np.c_[point[:, 0], np.zeros(len(t)), point[:, 2]]
             moment = torque + np.cross(centre - reference, force)

@@ -16,8 +16,8 @@ exact derivatives through them:
 ``target.contact_models``                    contact model plugins (belt speed etc.)
 ``target.set_joint_frame(joint, frame, quantity, axes, values)``   a joint's parent or child
                                              offset frame's translation (m) or X-Y-Z orientation
-                                             (rad) components := values (torque-driven
-                                             problems without contact models)
+                                             (rad) components := values (not with
+                                             muscle-driven controllers)
 ``target.error(message, element=...)``       InputError at the settings file
 """
 
@@ -106,22 +106,23 @@ class ModificationTarget:
         """Make components ``axes`` (0 = x, 1 = y, 2 = z) of ``joint``'s ``frame`` ('parent' or
         'child') offset ``quantity`` ('translation' m, 'orientation' rad, body-fixed X-Y-Z)
         equal to ``values`` (MX, one per axis). Every kinematic quantity of the problem
-        (inverse dynamics, markers, orientations, whole-body terms) then follows the moved
-        frame; tracked data keep the file's model."""
+        (inverse dynamics, markers, orientations, whole-body terms, elastic-foundation contact)
+        then follows the moved frame; tracked data keep the file's model."""
         from nmsm.model.parameters import ModelParameters
         from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 
         model = self.data.model
         if not isinstance(model, OsimTreatmentModel):
             raise self.error("joint-frame model functions need an .osim model", element="<input_model_file>")
-        if self.data.contact_models:
-            raise self.error("joint-frame model functions are not supported with contact models (their "
-                             "spring and sphere locations would not follow the frame)",
-                             element="<model_functions>", expected="a problem without contact surfaces")
+        fixed = [c.name for c in self.data.contact_models if not hasattr(c, "bind_model_parameters")]
+        if fixed:
+            raise self.error(f"contact model(s) {', '.join(fixed)} cannot follow a joint-frame model function",
+                             element="<model_functions>",
+                             expected="elastic-foundation contact surfaces (.osimx) or no contact model")
         if self._muscle_models():
             raise self.error("joint-frame model functions are not supported with muscle-driven controllers "
                              "(the surrogate and path muscle geometry is the file's)",
-                             element="<model_functions>", expected="torque-driven controllers only")
+                             element="<model_functions>", expected="torque (or no) controllers only")
         if frame not in ("parent", "child") or quantity not in ("translation", "orientation"):
             raise self.error(f"joint frame '{frame}' {quantity}", element="<RCNLParameterTerm>",
                              expected="frame parent|child and quantity translation|orientation")
@@ -143,3 +144,5 @@ class ModificationTarget:
         previous = self.data.model_parameter_values
         self.data.model_parameter_values = values if previous is None else cs.vertcat(previous, values)
         self.data.model = OsimTreatmentModel(model.model, parameters)
+        for contact in self.data.contact_models:
+            contact.bind_model_parameters(cs.reshape(self.data.model_parameter_values, 1, parameters.size))

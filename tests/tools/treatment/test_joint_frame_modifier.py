@@ -206,3 +206,82 @@ def test_settings_file_run_writes_the_designed_model(shared_data, tmp_path) -> N
     after = (tmp_path / "results" / "KickingModelDesignOpt.osim").read_text().splitlines()
     changed = [k for k, (a, b) in enumerate(zip(before, after)) if a != b]
     assert len(before) == len(after) and len(changed) == 1 and "<orientation>" in after[changed[0]]
+
+
+def test_elastic_foundation_contact_follows_the_frame(shared_data) -> None:
+    """GCP's spring contact on the tutorial body model with the ankle's parent frame as a
+    parameter: at the file's value the contact equals the file model's; moved 1 cm, the
+    springs move with the foot (forces change) and the reference point is the moved marker's."""
+    from nmsm.controllers.contact.elastic_foundation import ElasticFoundationContact
+    from nmsm.io.osimx import read_osimx
+    from nmsm.io.storage import read_storage
+
+    folder = shared_data / "gcp" / "uf_subject3_tutorial"
+    body = load_model(folder / "bodyModel.osim")
+    surface = read_osimx(folder / "CompletedSettingsFiles" / "GCPResultsV4" / "bodyModel_gcp.osimx").contact_surfaces[0]
+    plain_model = OsimTreatmentModel(body)
+    params = ModelParameters(body)
+    params.joint_frame_translation("ankle_r", "parent", components=(1,))
+    moved_model = OsimTreatmentModel(body, params)
+    contact = ElasticFoundationContact(surface, body, 0)
+    ik = read_storage(folder / "preprocessed" / "IKData" / "gait_1.sto")
+    ik = ik.to_radians({c for c in plain_model.coordinate_names if plain_model.is_rotational(c)})
+    q = ik.columns(plain_model.coordinate_names)[40]
+    qd = np.random.default_rng(2).normal(0, 0.5, q.size)
+    p_contact = np.asarray(contact.surface.parameters.vector(), dtype=float)
+    plain = [np.asarray(v) for v in contact.point_function(plain_model)(q, qd, p_contact)]
+    moved_function = contact.point_function(moved_model)
+    assert moved_function.size1_in(2) == p_contact.size + 1
+    at_file = [np.asarray(v) for v in moved_function(q, qd, np.r_[p_contact, params.initial_values])]
+    for a, b in zip(plain, at_file):
+        np.testing.assert_allclose(b, a, atol=1e-12)
+    shifted = params.initial_values + 0.01
+    moved = [np.asarray(v) for v in moved_function(q, qd, np.r_[p_contact, shifted])]
+    assert np.abs(moved[1] - plain[1]).max() > 1.0  # N: the springs moved with the foot
+    marker = np.asarray(moved_model.casadi.marker_function([surface.midfoot_superior_marker])(q, shifted)).ravel()
+    np.testing.assert_allclose(moved[3].ravel()[[0, 2]], marker[[0, 2]], atol=1e-12)
+    # the target binds the contact to the parameters' values
+    data = SimpleNamespace(model=plain_model, contact_models=[contact], controllers=[], model_parameter_values=None)
+    ModificationTarget(data, SimpleNamespace(settings_file="design.xml")).set_joint_frame(
+        "ankle_r", "parent", "translation", [1], [float(params.initial_values[0])])
+    assert contact.parameters().shape == (1, p_contact.size + 1)
+
+
+def test_design_with_ground_contact_starts_where_tracking_does(shared_data, tmp_path) -> None:
+    """A DO of the GCP tutorial's body model with ground contact, kinetic consistency and the
+    ankle's parent frame as a parameter at the file's value has the same starting cost as the
+    same problem as a TO: the contact, inverse dynamics and tracked reactions (moments about
+    the midfoot marker's floor point) follow the parameter consistently (``evaluate_only``)."""
+    import warnings
+
+    from test_treatment_contact import SETTINGS, SOLVER, _gcp
+
+    from nmsm.tools.treatment.run import run_settings
+
+    states = "hip_flexion_r knee_angle_r ankle_angle_r"
+    loads = " ".join(f"{c}_moment" for c in states.split())
+    (tmp_path / "solver.xml").write_text(SOLVER)
+    tracking = SETTINGS.format(out=tmp_path / "to", data=_gcp(shared_data), solver=tmp_path / "solver.xml",
+                               states=states, loads=loads).replace("</RCNLCostTermSet>", """<RCNLCostTerm>
+        <is_enabled>true</is_enabled><type>external_moment_tracking</type>
+        <moment_list>ground_moment_2_mx ground_moment_2_mz</moment_list><max_allowable_error>5</max_allowable_error>
+        </RCNLCostTerm></RCNLCostTermSet>""")
+    params = ModelParameters(load_model(_gcp(shared_data) / "bodyModel.osim"))
+    params.joint_frame_translation("ankle_r", "parent", components=(1,))
+    file_value = float(params.initial_values[0])
+    design = tracking.replace("TrackingOptimizationTool>", "DesignOptimizationTool>").replace(
+        f"<results_directory>{tmp_path / 'to'}</results_directory>",
+        f"<results_directory>{tmp_path / 'do'}</results_directory>").replace(
+        "<RCNLTorqueController>", f"""<model_functions>applyJointFrameTranslationParameter</model_functions>
+        <RCNLParameterTermSet><RCNLParameterTerm><type>joint_frame_translation_ankle</type>
+        <joint>ankle_r</joint><frame>parent</frame><axes>y</axes><initial_values>{file_value!r}</initial_values>
+        <lower_bounds>{file_value - 0.02!r}</lower_bounds><upper_bounds>{file_value + 0.02!r}</upper_bounds>
+        </RCNLParameterTerm></RCNLParameterTermSet><RCNLTorqueController>""", 1)
+    (tmp_path / "to.xml").write_text(tracking)
+    (tmp_path / "do.xml").write_text(design)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        to = run_settings(tmp_path / "to.xml", evaluate_only=True)
+        do = run_settings(tmp_path / "do.xml", evaluate_only=True)
+    assert do.prepared.data.model.parameter_count == 1 and to.prepared.data.model.parameter_count == 0
+    assert do.initial_cost == pytest.approx(to.initial_cost, rel=1e-12)
