@@ -21,10 +21,11 @@ Example: optimize where the elbow sits on the humerus (x and y in its parent fra
     <model_functions>applyJointFrameTranslationParameter</model_functions>
 
 Inverse dynamics, markers, body orientations, whole-body quantities and elastic-foundation
-contact follow the moved frame with exact derivatives (:meth:`~nmsm.tools.treatment.modifiers.ModificationTarget.set_joint_frame`);
-tracked data keep the file's model. Not with muscle-driven controllers (their geometry is the
-file's); GCP's elastic-foundation contact follows the frame.
-The original has no such built-in (tools.md §11.1 lists muscle and belt-speed parameters).
+contact follow the moved frame with exact derivatives
+(:meth:`~nmsm.tools.treatment.modifiers.ModificationTarget.set_joint_frame`); tracked data keep
+the file's model. Not with muscle-driven controllers (their muscle geometry is the file's).
+Values are absolute; the solved model is written as ``<model>DesignOpt.osim``. The original
+has no such built-in (tools.md §11.1 lists muscle and belt-speed parameters).
 """
 
 from __future__ import annotations
