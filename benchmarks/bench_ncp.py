@@ -63,17 +63,20 @@ def _variant(target: Path, activation_error: str) -> Path:
     return target
 
 
-def free_activation_moment_rms(run) -> np.ndarray:
-    """Moment RMS per coordinate (N·m) with each frame's activations free in [0, 1] (no synergies)."""
+def trial_gains(run) -> list:
+    """Per trial ``(trial, MomentGains)`` of the run's muscles (computed once, used by the bounds)."""
     inputs = run.setup.inputs
-    squared, frames = 0.0, 0
-    for trial in inputs.trials:
-        gains = moment_gains(trial, inputs.muscles, inputs.v_max_factor)
-        for p in range(gains.active.shape[0]):
-            fit = lsq_linear(gains.active[p], trial.moments[p] - gains.passive[p], bounds=(0.0, 1.0))
-            squared = squared + (gains.active[p] @ fit.x + gains.passive[p] - trial.moments[p]) ** 2
-            frames += 1
-    return np.sqrt(squared / frames)
+    return [(trial, moment_gains(trial, inputs.muscles, inputs.v_max_factor)) for trial in inputs.trials]
+
+
+def free_activation_moment_rms(gains: list) -> np.ndarray:
+    """Moment RMS per coordinate (N·m) with each frame's activations free in [0, 1] (no synergies)."""
+    errors = []
+    for trial, g in gains:
+        for p in range(trial.n_points):
+            target = trial.moments[p] - g.passive[p]
+            errors.append(g.active[p] @ lsq_linear(g.active[p], target, bounds=(0.0, 1.0)).x - target)
+    return np.sqrt(np.mean(np.square(errors), axis=0))
 
 
 def _term(run, kind: str):
@@ -84,7 +87,7 @@ def _term(run, kind: str):
     raise LookupError(f"no enabled '{kind}' term in the settings")
 
 
-def settings_weight_bound(run) -> tuple[np.ndarray, float]:
+def settings_weight_bound(run, gains: list) -> tuple[np.ndarray, float]:
     """Per-coordinate moment RMS (J,) N·m and pooled activation RMS of each frame's
     activations free in [0, 1] minimizing the settings' moment-tracking, activation-tracking
     and activation-minimization terms (each term ``mean((raw / e)**2)`` as in the cost)."""
@@ -92,38 +95,32 @@ def settings_weight_bound(run) -> tuple[np.ndarray, float]:
     e_moment = _term(run, "moment_tracking").max_allowable_error
     e_tracking = _term(run, "activation_tracking").max_allowable_error
     minimization = _term(run, "activation_minimization")
-    e_minimum, center = minimization.max_allowable_error, minimization.error_center
-    tracked = list(inputs.mtp_indices)
-    untracked = [i for i in range(inputs.layout.n_muscles) if i not in set(tracked)]
-    n_muscles, n_loads = inputs.layout.n_muscles, len(inputs.coordinates)
-    select = np.eye(n_muscles)
-    rows_tracked = select[tracked] / (e_tracking * np.sqrt(len(tracked)))
-    rows_untracked = select[untracked] / (e_minimum * np.sqrt(max(len(untracked), 1)))
-    moment_scale = 1.0 / (e_moment * np.sqrt(n_loads))
+    tracked, untracked = list(inputs.mtp_indices), list(inputs.other_indices)
+    tracking_weight = 1.0 / (e_tracking * np.sqrt(len(tracked)))
+    minimum_weight = 1.0 / (minimization.max_allowable_error * np.sqrt(max(len(untracked), 1)))
+    moment_weight = 1.0 / (e_moment * np.sqrt(len(inputs.coordinates)))
+    select = np.eye(inputs.layout.n_muscles)
+    rows = np.vstack([select[tracked] * tracking_weight, select[untracked] * minimum_weight])
     moment_errors, activation_errors = [], []
-    for trial in inputs.trials:
-        gains = moment_gains(trial, inputs.muscles, inputs.v_max_factor)
+    for trial, g in gains:
         for p in range(trial.n_points):
-            target = trial.moments[p] - gains.passive[p]
-            system = np.vstack([gains.active[p] * moment_scale, rows_tracked, rows_untracked])
-            rhs = np.concatenate([target * moment_scale, rows_tracked[:, tracked] @ trial.mtp_activations[p],
-                                  rows_untracked[:, untracked] @ np.full(len(untracked), center)])
-            x = lsq_linear(system, rhs, bounds=(0.0, 1.0)).x
-            moment_errors.append(gains.active[p] @ x - target)
+            target = trial.moments[p] - g.passive[p]
+            rhs = np.concatenate([target * moment_weight, trial.mtp_activations[p] * tracking_weight,
+                                  np.full(len(untracked), minimization.error_center * minimum_weight)])
+            x = lsq_linear(np.vstack([g.active[p] * moment_weight, rows]), rhs, bounds=(0.0, 1.0)).x
+            moment_errors.append(g.active[p] @ x - target)
             activation_errors.append(x[tracked] - trial.mtp_activations[p])
-    moment_rms = np.sqrt(np.mean(np.square(moment_errors), axis=0))
-    return moment_rms, float(np.sqrt(np.mean(np.square(activation_errors))))
+    return np.sqrt(np.mean(np.square(moment_errors), axis=0)), float(np.sqrt(np.mean(np.square(activation_errors))))
 
 
-def mtp_activation_moment_rms(run) -> np.ndarray:
+def mtp_activation_moment_rms(run, gains: list) -> np.ndarray:
     """Per-coordinate moment RMS (J,) N·m of the MTP activations as they are, other muscles at 0."""
-    inputs = run.setup.inputs
-    tracked = list(inputs.mtp_indices)
+    tracked = list(run.setup.inputs.mtp_indices)
     errors = []
-    for trial in inputs.trials:
-        activations = np.zeros((trial.n_points, inputs.layout.n_muscles))
+    for trial, g in gains:
+        activations = np.zeros((trial.n_points, run.setup.inputs.layout.n_muscles))
         activations[:, tracked] = trial.mtp_activations
-        errors.append(moment_gains(trial, inputs.muscles, inputs.v_max_factor).moments(activations) - trial.moments)
+        errors.append(g.moments(activations) - trial.moments)
     return np.sqrt(np.mean(np.square(np.vstack(errors)), axis=0))
 
 
@@ -156,13 +153,14 @@ def main() -> None:
         print(f"| mean | {m.mean_moment_rms:.3f} |")
         print(f"activation RMS (90 MTP muscles) {m.activation_rms_pooled:.4f}, VAF {100 * m.activation_vaf:.2f} %")
         if args.free_bound:
-            free = free_activation_moment_rms(run)
+            gains = trial_gains(run)
+            free = free_activation_moment_rms(gains)
             print(f"free activations in [0, 1] (no synergies): mean moment RMS {free.mean():.4f} N·m, "
                   f"largest {free.max():.4f} N·m")
-            mtp = mtp_activation_moment_rms(run)
+            mtp = mtp_activation_moment_rms(run, gains)
             print(f"MTP activations as they are (other muscles 0): mean moment RMS {mtp.mean():.2f} N·m, largest "
                   f"{mtp.max():.2f} N·m ({m.coordinates[int(np.argmax(mtp))]})")
-            bound, activation = settings_weight_bound(run)
+            bound, activation = settings_weight_bound(run, gains)
             print(f"free activations at the settings' weights (no synergies): mean moment RMS {bound.mean():.2f} N·m, "
                   f"activation RMS {activation:.4f}")
         if args.sweep:
