@@ -99,7 +99,7 @@ def write_design_model(stage: Path, prepared: Any, tsol: Any) -> list[Path]:
 
     data = prepared.data
     model = data.model
-    if not getattr(model, "parameter_count", 0) or data.model_parameter_values is None:
+    if not getattr(model, "parameter_count", 0):
         return []
     values = np.asarray(tsol.value(data.model_parameter_values), dtype=float).ravel()
     source = Path(model.file)

@@ -18,7 +18,7 @@ from nmsm.controllers.torque import TorqueController
 from nmsm.errors import InputError
 from nmsm.model import CasadiModel, load_model
 from nmsm.model.parameters import ModelParameters
-from nmsm.modifiers.joint_frame import ApplyJointFrameOrientationParameter, ApplyJointFrameTranslationParameter
+from nmsm.modifiers.joint_frame import ApplyJointFrameOrientationParameter
 from nmsm.terms.treatment.inverse_dynamics import InverseDynamicsLoadTracking
 from nmsm.terms.treatment.kinematics import GeneralizedCoordinateTracking
 from nmsm.tools.treatment.bounds import RangeRule, range_bounds
@@ -163,7 +163,6 @@ def test_bad_joint_frame_settings(arm) -> None:
         _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], settings=_settings(axes="z w"))
     with pytest.raises(InputError, match="1 values for 2 axes"):
         _build(arm, [GeneralizedCoordinateTracking(coordinate=COORDINATE)], settings=_settings(axes="x z"))
-    assert ApplyJointFrameTranslationParameter.type == "applyJointFrameTranslationParameter"
 
 
 def test_settings_file_run_writes_the_designed_model(shared_data, tmp_path) -> None:
