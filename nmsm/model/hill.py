@@ -215,16 +215,23 @@ def muscle_volume(max_isometric_force: Any, optimal_fiber_length: Any, maximum_m
 
 # ----- activation ---------------------------------------------------------------------------
 def clip_negative(x: Any, smoothing: float = 0.0) -> Any:
-    """``max(x, 0)``; with ``smoothing`` > 0 the smooth ``(x + sqrt(x**2 + s**2)) / 2``.
+    """``max(x, 0)``; with ``smoothing`` = s > 0 a twice continuously differentiable ramp.
 
-    The smooth form is C-infinity and exceeds ``max(x, 0)`` by at most ``s / 2`` (at 0), so
-    gradient-based solvers do not stall on the kink (MTP with synergy extrapolation).
+    The smooth ramp equals ``max(x, 0)`` outside ``|x| < s``; inside it is
+    ``s g(x/s)`` with ``g(t) = t/2 + 3/16 + 3t^2/8 - t^4/16`` (value, slope and curvature
+    match at ``t = +-1``). It exceeds ``max(x, 0)`` by at most ``3 s / 16`` (at 0) and its
+    curvature is at most ``3 / (4 s)``, so gradient-based solvers neither stall on the kink
+    nor face a near-kink (MTP with synergy extrapolation).
     """
     ops = _ops(x)
     if smoothing <= 0:
         return ops.fmax(x, 0) if ops is not np else np.maximum(x, 0.0)
-    return 0.5 * (x + ops.sqrt(x * x + smoothing**2))
-
+    s = float(smoothing)
+    t = x / s
+    ramp = s * (0.5 * t + 3.0 / 16.0 + 0.375 * t * t - t**4 / 16.0)
+    if ops is np:
+        return np.where(np.abs(t) < 1.0, ramp, np.maximum(x, 0.0))
+    return ops.if_else(ops.fabs(t) < 1.0, ramp, ops.fmax(x, 0))
 
 
 def activation_nonlinearity(neural_activation: Any, nonlinearity: Any) -> Any:

@@ -109,9 +109,30 @@ def test_activation_nonlinearity():
 def test_clip_negative():
     x = np.array([-1.0, 0.0, 2.0])
     assert np.array_equal(hill.clip_negative(x), [0.0, 0.0, 2.0])
-    smooth = hill.clip_negative(x, 1e-4)
-    assert np.all(smooth >= hill.clip_negative(x))
-    assert np.all(smooth - hill.clip_negative(x) <= 0.5e-4 + 1e-15)
+    s = 0.01
+    x = np.linspace(-3 * s, 3 * s, 601)
+    hard = np.maximum(x, 0.0)
+    smooth = hill.clip_negative(x, s)
+    assert np.all(smooth >= hard)
+    assert np.max(smooth - hard) == pytest.approx(3 * s / 16, rel=1e-12)  # at 0
+    outside = np.abs(x) >= s
+    assert np.array_equal(smooth[outside], hard[outside])
+    assert np.allclose(_cs(lambda v: hill.clip_negative(v, s), x), smooth, atol=1e-15)
+
+
+def test_clip_negative_ramp_is_twice_differentiable():
+    """Value, slope and curvature of the smooth ramp are continuous at +-s (exact AD)."""
+    s = 0.01
+    v = cs.SX.sym("v")
+    f = hill.clip_negative(v, s)
+    fun = cs.Function("f", [v], [f, cs.gradient(f, v), cs.hessian(f, v)[0]])
+    for edge, (value, slope) in ((-s, (0.0, 0.0)), (s, (s, 1.0))):
+        for side in (edge * (1 - 1e-9), edge * (1 + 1e-9)):
+            out = [float(o) for o in fun(side)]
+            assert out[0] == pytest.approx(value, abs=1e-10)
+            assert out[1] == pytest.approx(slope, abs=1e-6)
+            assert out[2] == pytest.approx(0.0, abs=1e-5)
+    assert float(fun(0.0)[2]) == pytest.approx(3 / (4 * s))
 
 
 def test_active_force_length_guarded_where_a_width_vanishes():
