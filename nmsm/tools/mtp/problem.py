@@ -214,8 +214,9 @@ def build_task_problem(
 ) -> tuple[OptimizationProblem, MtpContext]:
     """The task's problem (variables, terms, constraints) and the terms' context.
 
-    ``lift``: tendon forces and moments become decision variables (``tendon_forces_<trial>``,
-    ``moments_<trial>``, with SynX also ``synx_...``) with equality constraints to the
+    ``lift``: activations, tendon forces and moments become decision variables
+    (``activations_<trial>``, ``tendon_forces_<trial>``, ``moments_<trial>``, with SynX also
+    ``synx_...``) with equality constraints to the
     modeled ones. The solution is the same; exact Jacobians and Hessians stay sparse (the
     moments couple all muscles only through the linear sum of forces), which makes IPOPT
     with exact second derivatives fast.
@@ -295,29 +296,32 @@ def build_task_problem(
 def _lift(
     problem: OptimizationProblem, data: MtpData, state: MtpState, chains: Sequence[TrialChain]
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]] | None]:
-    """Lifted variables per trial (tendon forces, moments) at ``state``'s values.
+    """Lifted variables per trial (activations, tendon forces, moments) at ``state``'s values.
 
-    Every lifting equality then depends on one muscle's parameters at one frame (forces)
-    or on one frame's forces (moments, linear): exact Jacobians and Hessians need few
-    colours (see :mod:`nmsm.tools.mtp.derivatives`). Forces are scaled by each muscle's
-    ``F0 cos(alpha)`` and moments by each coordinate's largest ID moment, variables and
-    equality rows alike, so all lifted quantities are O(1). (Activations are not lifted:
-    their rows share the activation parameters and synergy weights, which only adds
-    variables and fill-in.)
+    Every lifting equality then depends on one muscle's parameters (activations: through
+    the activation dynamics of one muscle; forces: one frame's activation and the muscle's
+    length scales) or on one frame's forces (moments, linear): exact Jacobians and Hessians
+    need few colours (see :mod:`nmsm.tools.mtp.derivatives`), and the activation cost terms
+    become quadratic in variables. Forces are scaled by each muscle's ``F0 cos(alpha)`` and
+    moments by each coordinate's largest ID moment, variables and equality rows alike, so
+    all lifted quantities are O(1). (Lifting the activations halved the Hessian time and
+    the IPOPT time of Patient 3: 297 s -> 179 s, docs/mtp.md; lifting activations but not
+    forces was slower, 264 s.)
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
-    fields = ("tendon_force", "moments")
+    fields = ("activations", "tendon_force", "moments")
     models = plain + (synx or [])
     values = cs.Function("lift_start", [], [getattr(m, f) for m in models for f in fields]).call([])
     force_scale = (data.muscles.max_isometric_force * np.cos(data.muscles.pennation_angle)).reshape(1, -1)
     out: list[dict[str, Any]] = []
     for i, model in enumerate(models):
-        force, mom = (np.array(values[i * len(fields) + j].full()) for j in range(len(fields)))
+        act, force, mom = (np.array(values[i * len(fields) + j].full()) for j in range(len(fields)))
         prefix = "" if i < len(plain) else "synx_"
         trial = data.trials[i % len(plain)]
         moment_scale = np.maximum(np.abs(trial.inverse_dynamics_moments).max(axis=0), 1.0).reshape(1, -1)
         out.append({
+            "activations": problem.variable(f"{prefix}activations_{model.name}", act, scale=1.0),
             "forces": problem.variable(f"{prefix}tendon_forces_{model.name}", force, scale=force_scale),
             "moments": problem.variable(f"{prefix}moments_{model.name}", mom, scale=moment_scale),
             "force_scale": force_scale,
@@ -334,6 +338,8 @@ def _lifting_constraints(problem: OptimizationProblem, models: Sequence[TrialMod
         n = int(model.activations.shape[0])
         force_rows = cs.DM(np.repeat(1.0 / values["force_scale"], n, axis=0))
         moment_rows = cs.DM(np.repeat(1.0 / values["moment_scale"], n, axis=0))
+        problem.add_constraint(f"lifted_{prefix}activations_{name}",
+                               values["activations"] - model.modeled_activations, 0.0, 0.0)
         problem.add_constraint(f"lifted_{prefix}forces_{name}",
                                (values["forces"] - model.modeled_tendon_force) * force_rows, 0.0, 0.0)
         problem.add_constraint(f"lifted_{prefix}moments_{name}",
