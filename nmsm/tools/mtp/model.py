@@ -107,8 +107,8 @@ class TrialChain:
 
     ``stride``: the EMG spline goes through every ``stride``-th EMG sample (the original's
     Synergy Extrapolation path uses 4; see :class:`nmsm.tools.mtp.problem.MtpData`).
-    ``clip_smoothing``: width (-) of the smooth version of "negative neural activations set
-    to 0" (:func:`nmsm.model.hill.clip_negative`); 0 = the original's hard clip.
+    ``clip_smoothing``: half-width (-) of the smooth ramp replacing "negative neural
+    activations set to 0" (:func:`nmsm.model.hill.clip_negative`); 0 = the original's hard clip.
     """
 
     def __init__(

@@ -55,7 +55,8 @@ SYNERGY_WEIGHT_BOUNDS = (-100.0, 100.0)
 #: nmsm.model.hill.clip_negative): exact outside |x| < 0.01, at most 0.0019 above max(x, 0).
 #: The original clips hard, which stalls IPOPT when synergy extrapolation drives excitations
 #: below 0; a narrow smoothing (1e-4) leaves a near-kink of curvature ~1e4 that IPOPT crawls
-#: through (Patient 3: 482 iterations, 1269 s; with 0.01: 146 iterations, 290 s; docs/mtp.md).
+#: through (Patient 3: 482 iterations, 1269 s in IPOPT; with 0.01: 146 iterations, 297 s;
+#: docs/mtp.md).
 DEFAULT_CLIP_SMOOTHING = 1e-2
 #: soft-maximum sharpness and limits of the normalized-fiber-length constraints
 CONSTRAINT_SHARPNESS = 500.0
@@ -304,9 +305,9 @@ def _lift(
     need few colours (see :mod:`nmsm.tools.mtp.derivatives`), and the activation cost terms
     become quadratic in variables. Forces are scaled by each muscle's ``F0 cos(alpha)`` and
     moments by each coordinate's largest ID moment, variables and equality rows alike, so
-    all lifted quantities are O(1). (Lifting the activations halved the Hessian time and
-    the IPOPT time of Patient 3: 297 s -> 179 s, docs/mtp.md; lifting activations but not
-    forces was slower, 264 s.)
+    all lifted quantities are O(1). (Lifting the activations cut Patient 3's Hessian from
+    1.19 s to 0.33 s per iteration and its IPOPT time from 297 s to 179 s, docs/mtp.md;
+    lifting activations but not forces was slower, 264 s.)
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
