@@ -12,7 +12,6 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-import pytest
 
 from nmsm.tools.mtp.report import moment_rms
 from nmsm.tools.mtp.run import run_settings
