@@ -91,7 +91,7 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
                     close = close_matches(name, list(pool))
                     hint = f"; close matches: {', '.join(close)}" if close else ""
                     raise InputError(f"marker '{name}' is not in the {what} {where}{hint}", file=settings_file or where,
-                                     element=element, expected=f"markers present in both the marker file and the model")
+                                     element=element, expected="markers present in both the marker file and the model")
             names.append(name)
             values_list.append(float(weight))
         if not names:

@@ -162,7 +162,6 @@ def run_mtli(
         casadi_options=gauss_newton_hessian(problem),
     )
     v = solution.values
-    m = muscles.n_muscles
     if options.absolute_lengths:
         lo = v["optimal_fiber_length"].ravel()
         lts = v["tendon_slack_length"].ravel()

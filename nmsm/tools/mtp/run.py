@@ -34,15 +34,14 @@ from nmsm.io.osimx import OsimxModel, read_osimx
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
 from nmsm.tools.mtp import outputs
-from nmsm.tools.mtp.data import TrialData, check_same_frame_counts, find_prefixes, load_trial
+from nmsm.tools.mtp.data import check_same_frame_counts, find_prefixes, load_trial
 from nmsm.tools.mtp.derivatives import blockwise_derivatives
 from nmsm.tools.mtp.evaluation import ModeledValues, check_fiber_lengths, evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model_info import muscle_parameters, muscles_crossing
 from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, passive_moments_at, run_mtli
 from nmsm.tools.mtp.mtli_model import PassiveTrial
-from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters, channel_map, resolve_groups
+from nmsm.tools.mtp.muscles import MuscleParameters, channel_map, resolve_groups
 from nmsm.tools.mtp.problem import (
-    BLOCKS,
     MtpData,
     MtpState,
     TaskSettings,

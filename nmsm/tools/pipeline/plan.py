@@ -10,7 +10,6 @@
 
 from __future__ import annotations
 
-from nmsm.errors import InputError
 from nmsm.tools.pipeline.artifacts import ARTIFACTS, INPUT_ELEMENTS
 from nmsm.tools.pipeline.kinds import order_text, stage_kinds
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec

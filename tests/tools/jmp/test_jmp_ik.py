@@ -176,7 +176,7 @@ def test_ik_settings_file_with_weights_and_a_coordinate_task(leg, tmp_path):
     trc = tmp_path / "leg.trc"
     write_trc(trc, table, units="m")
     settings = tmp_path / "ik.xml"
-    settings.write_text(f"""<?xml version="1.0" encoding="UTF-8" ?>
+    settings.write_text("""<?xml version="1.0" encoding="UTF-8" ?>
 <OpenSimDocument Version="40000">
   <InverseKinematicsTool>
     <accuracy>1e-10</accuracy>

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.storage import read_storage, table_from_columns, write_storage

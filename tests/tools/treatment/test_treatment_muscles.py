@@ -8,7 +8,6 @@ from typing import Any
 
 import casadi as cs
 import numpy as np
-import pytest
 
 from nmsm.io.storage import read_storage
 from nmsm.tools.treatment.modifiers import ModificationTarget

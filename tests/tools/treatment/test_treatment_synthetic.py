@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from nmsm.constraints.treatment.dynamics import KineticConsistency
 from nmsm.constraints.treatment.terminal import (
