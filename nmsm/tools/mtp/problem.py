@@ -306,8 +306,9 @@ def _lift(
     become quadratic in variables. Forces are scaled by each muscle's ``F0 cos(alpha)`` and
     moments by each coordinate's largest ID moment, variables and equality rows alike, so
     all lifted quantities are O(1). (Lifting the activations cut Patient 3's Hessian from
-    1.19 s to 0.33 s per iteration and its IPOPT time from 297 s to 179 s, docs/mtp.md;
-    lifting activations but not forces was slower, 264 s.)
+    1.19 s to 0.33 s per iteration and its benchmark IPOPT time from 297 s to 184 s,
+    docs/mtp.md; in the same experiment series, lifting activations but not forces took
+    264 s of IPOPT time where lifting both took 179 s.)
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)
