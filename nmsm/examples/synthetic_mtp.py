@@ -28,7 +28,7 @@ from nmsm.tools.mtp.data import TrialData
 from nmsm.tools.mtp.evaluation import evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model import MuscleDesign
 from nmsm.tools.mtp.muscles import MuscleParameters
-from nmsm.tools.mtp.problem import MtpData, MtpState, TaskSettings, build_task_problem, updated_state
+from nmsm.tools.mtp.problem import TASK_MU_INIT, MtpData, MtpState, TaskSettings, build_task_problem, updated_state
 
 #: recovery tolerances (absolute, in each block's units) of :func:`recover`: the data are
 #: exact and the parameters identifiable (as many coordinates as muscles), so IPOPT with
@@ -127,7 +127,7 @@ def recover(case: SyntheticMtp, *, max_iterations: int = 500) -> tuple[MtpState,
     state = MtpState.initial(case.data)
     problem, _ = build_task_problem(case.data, state, task, initial_fiber_lengths(case.data))
     solution = problem.solve("ipopt", max_iter=max_iterations, tol=1e-10, print_level=0,
-                             casadi_options=blockwise_derivatives(problem))
+                             ipopt_options={"mu_init": TASK_MU_INIT}, casadi_options=blockwise_derivatives(problem))
     return updated_state(state, solution.values), solution.cost, solution.iterations
 
 

@@ -63,6 +63,13 @@ CONSTRAINT_SHARPNESS = 500.0
 CONSTRAINT_MAX_LENGTH = 1.3
 CONSTRAINT_MIN_LENGTH = 0.3
 
+#: IPOPT's initial barrier parameter for MTP tasks (``nmsm run`` and the synthetic case;
+#: IPOPT's default 0.1, which MTLI keeps), chosen by measurement (2026-11-25, docs/mtp.md):
+#: Patient 3 144 -> 118 iterations, cost 65.2784 -> 65.2657; tutorial V1 36 -> 40, V2 30 -> 26,
+#: V3 15 -> 14, V1 with NMF 26 -> 36, 40 synthetic known-answer cases 584 -> 558 in all (these
+#: with the same costs to 1e-4, each synthetic case recovering the truth).
+TASK_MU_INIT = 1e-3
+
 
 @attrs.frozen(eq=False)
 class MtpData:

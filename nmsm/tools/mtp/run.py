@@ -42,6 +42,7 @@ from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, pa
 from nmsm.tools.mtp.mtli_model import PassiveTrial
 from nmsm.tools.mtp.muscles import MuscleParameters, channel_map, resolve_groups
 from nmsm.tools.mtp.problem import (
+    TASK_MU_INIT,
     MtpData,
     MtpState,
     TaskSettings,
@@ -239,6 +240,7 @@ def solve_tasks(
             max_iter=int(max_iterations if max_iterations is not None else setup.settings.max_iterations),
             tol=tolerance,
             print_level=print_level,
+            ipopt_options={"mu_init": TASK_MU_INIT},
             casadi_options=blockwise_derivatives(problem),
         )
         if not all(np.all(np.isfinite(v)) for v in solution.values.values()):

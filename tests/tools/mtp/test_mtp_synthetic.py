@@ -9,10 +9,10 @@ from nmsm.examples.synthetic_mtp import TOLERANCES, make_synthetic_mtp, recover,
 
 @pytest.mark.parametrize("n_muscles, n_trials, seed", [(3, 2, 3), (5, 3, 11)])
 def test_recovers_true_parameters(n_muscles, n_trials, seed):
-    """IPOPT is a local method and starts at the original's initial values, so a few seeds
-    end in a local minimum: measured 2026-11-25 over 120 seeds of 3-6 muscles, 1 (5 muscles,
-    3 trials, seed 23) with the fiber-length limits at the extreme muscle-tendon lengths and
-    2 with per-frame rows; the seeds here recover the truth."""
+    """IPOPT is a local method and starts at the original's initial values, so a seed can
+    end in a local minimum: measured 2026-11-25 over 120 seeds of 3-6 muscles, none with
+    ``TASK_MU_INIT`` (1718 iterations in all); with IPOPT's default barrier start 1 (5 muscles,
+    3 trials, seed 23) and 2 with per-frame fiber-length rows. The seeds here recover the truth."""
     case = make_synthetic_mtp(n_muscles=n_muscles, n_trials=n_trials, seed=seed)
     estimate, cost, _ = recover(case)
     errors = recovery_errors(case, estimate)
