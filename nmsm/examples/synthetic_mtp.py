@@ -28,7 +28,14 @@ from nmsm.tools.mtp.data import TrialData
 from nmsm.tools.mtp.evaluation import evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model import MuscleDesign
 from nmsm.tools.mtp.muscles import MuscleParameters
-from nmsm.tools.mtp.problem import TASK_MU_INIT, MtpData, MtpState, TaskSettings, build_task_problem, updated_state
+from nmsm.tools.mtp.problem import (
+    MtpData,
+    MtpState,
+    TaskSettings,
+    build_task_problem,
+    solve_task_problem,
+    updated_state,
+)
 
 #: recovery tolerances (absolute, in each block's units) of :func:`recover`: the data are
 #: exact and the parameters identifiable (as many coordinates as muscles), so IPOPT with
@@ -120,14 +127,12 @@ def recover(case: SyntheticMtp, *, max_iterations: int = 500) -> tuple[MtpState,
     Returns ``(estimate, final cost, iterations)``.
     """
     from nmsm.core.registry import get_registry
-    from nmsm.tools.mtp.derivatives import blockwise_derivatives
 
     term = get_registry().get("cost", "inverse_dynamics_joint_moment", "MTP")(max_allowable_error=0.01)
     task = TaskSettings(cost_terms=(term,))
     state = MtpState.initial(case.data)
     problem, _ = build_task_problem(case.data, state, task, initial_fiber_lengths(case.data))
-    solution = problem.solve("ipopt", max_iter=max_iterations, tol=1e-10, print_level=0,
-                             ipopt_options={"mu_init": TASK_MU_INIT}, casadi_options=blockwise_derivatives(problem))
+    solution = solve_task_problem(problem, max_iterations=max_iterations, tolerance=1e-10)
     return updated_state(state, solution.values), solution.cost, solution.iterations
 
 

@@ -7,7 +7,8 @@ constraint block and the objective get their own derivative (their own colouring
 or reverse), and the results are stacked / summed. Values are identical to the
 default; only the cost changes.
 
-Use: ``problem.solve("ipopt", casadi_options=blockwise_derivatives(problem))``.
+Use: ``problem.solve("ipopt", casadi_options=blockwise_derivatives(problem))`` (MTP tasks:
+:func:`nmsm.tools.mtp.problem.solve_task_problem`).
 """
 
 from __future__ import annotations

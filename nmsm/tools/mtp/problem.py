@@ -33,10 +33,11 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.core.problem import OptimizationProblem
+from nmsm.core.problem import OptimizationProblem, Solution
 from nmsm.core.term import CostTerm
 from nmsm.tools.mtp.context import MtpContext
 from nmsm.tools.mtp.data import TrialData
+from nmsm.tools.mtp.derivatives import blockwise_derivatives
 from nmsm.tools.mtp.model import MuscleDesign, TrialChain, TrialModel, expand_emg, scaled_emg_samples
 from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters
 from nmsm.tools.mtp.synx import SynergyExtrapolation
@@ -63,8 +64,8 @@ CONSTRAINT_SHARPNESS = 500.0
 CONSTRAINT_MAX_LENGTH = 1.3
 CONSTRAINT_MIN_LENGTH = 0.3
 
-#: IPOPT's initial barrier parameter for MTP tasks (``nmsm run`` and the synthetic case;
-#: IPOPT's default 0.1, which MTLI keeps), chosen by measurement (2026-11-25, docs/mtp.md):
+#: IPOPT's initial barrier parameter of :func:`solve_task_problem` (IPOPT's default 0.1, which
+#: MTLI keeps), chosen by measurement (2026-11-25, docs/mtp.md):
 #: Patient 3 144 -> 118 iterations, cost 65.2784 -> 65.2657; tutorial V1 36 -> 40, V2 30 -> 26,
 #: V3 15 -> 14, V1 with NMF 26 -> 36, 40 synthetic known-answer cases 584 -> 558 in all (these
 #: with the same costs to 1e-4, each synthetic case recovering the truth).
@@ -299,6 +300,21 @@ def build_task_problem(
     if data.synx is not None and data.synx.missing_muscles:
         problem.add_constraint("extrapolated_excitation_0_1", data.synx.extrapolated_bounds_expression(weights), 0.0, 1.0)
     return problem, ctx
+
+
+def solve_task_problem(problem: OptimizationProblem, *, max_iterations: int, tolerance: float = 1e-6,
+                       print_level: int = 0) -> Solution:
+    """Solve an MTP task problem as ``nmsm run`` does: IPOPT with block-wise exact
+    derivatives (:func:`nmsm.tools.mtp.derivatives.blockwise_derivatives`) and
+    ``mu_init`` = :data:`TASK_MU_INIT`."""
+    return problem.solve(
+        "ipopt",
+        max_iter=int(max_iterations),
+        tol=float(tolerance),
+        print_level=print_level,
+        ipopt_options={"mu_init": TASK_MU_INIT},
+        casadi_options=blockwise_derivatives(problem),
+    )
 
 
 def _lift(

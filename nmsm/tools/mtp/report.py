@@ -20,10 +20,9 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.osimx import read_osimx
 from nmsm.io.storage import read_storage
-from nmsm.tools.mtp.derivatives import blockwise_derivatives
 from nmsm.tools.mtp.evaluation import initial_fiber_lengths
 from nmsm.tools.mtp.model import MuscleDesign
-from nmsm.tools.mtp.problem import BLOCKS, MtpData, MtpState, TaskSettings, build_task_problem
+from nmsm.tools.mtp.problem import BLOCKS, MtpData, MtpState, TaskSettings, build_task_problem, solve_task_problem
 
 
 @attrs.frozen
@@ -74,8 +73,7 @@ def score_parameters(
     if data.synx is None:
         costs = problem.term_costs(problem.initial_scaled())
         return Score(float(sum(costs.values())), costs), state
-    solution = problem.solve("ipopt", max_iter=max_iterations, print_level=0,
-                             casadi_options=blockwise_derivatives(problem))
+    solution = solve_task_problem(problem, max_iterations=max_iterations)
     weights = np.asarray(solution.values["synergy_weights"]).ravel()
     return Score(solution.cost, dict(solution.term_costs)), MtpState(state.design, weights)
 

@@ -35,19 +35,18 @@ from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
 from nmsm.tools.mtp import outputs
 from nmsm.tools.mtp.data import check_same_frame_counts, find_prefixes, load_trial
-from nmsm.tools.mtp.derivatives import blockwise_derivatives
 from nmsm.tools.mtp.evaluation import ModeledValues, check_fiber_lengths, evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model_info import muscle_parameters, muscles_crossing
 from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, passive_moments_at, run_mtli
 from nmsm.tools.mtp.mtli_model import PassiveTrial
 from nmsm.tools.mtp.muscles import MuscleParameters, channel_map, resolve_groups
 from nmsm.tools.mtp.problem import (
-    TASK_MU_INIT,
     MtpData,
     MtpState,
     TaskSettings,
     absorb_length_scales,
     build_task_problem,
+    solve_task_problem,
     updated_state,
 )
 from nmsm.tools.mtp.synx import build_synergy_extrapolation
@@ -235,13 +234,11 @@ def solve_tasks(
         _log(verbose, f"task {k}: building the problem")
         problem, _ = build_task_problem(data, state, task, initial_lengths, name=f"MTP_task_{k}")
         _log(verbose, f"task {k}: {problem.n_variables} variables; solving with IPOPT")
-        solution = problem.solve(
-            "ipopt",
-            max_iter=int(max_iterations if max_iterations is not None else setup.settings.max_iterations),
-            tol=tolerance,
+        solution = solve_task_problem(
+            problem,
+            max_iterations=max_iterations if max_iterations is not None else setup.settings.max_iterations,
+            tolerance=tolerance,
             print_level=print_level,
-            ipopt_options={"mu_init": TASK_MU_INIT},
-            casadi_options=blockwise_derivatives(problem),
         )
         if not all(np.all(np.isfinite(v)) for v in solution.values.values()):
             raise SolverError(f"MTP task {k} returned non-finite values ({solution.status})")
