@@ -27,6 +27,8 @@ from nmsm.model.components import GROUND, Model
 TIME_MATCH_TOLERANCE = 5e-3
 #: largest relative deviation of the motion's frame intervals from their mean
 EVEN_SPACING_TOLERANCE = 1e-3
+#: frames whose force magnitude exceeds this fraction of the window's peak count as loaded
+LOADED_FRACTION = 0.05
 
 
 @attrs.frozen(eq=False)
@@ -126,7 +128,40 @@ def foot_ground_reactions(grf: Table, motion_time: np.ndarray, force_columns: tu
     if np.isnan(forces).any() or np.isnan(moments).any():
         raise InputError("force or moment columns contain NaN in the window", file=grf_file,
                          expected="finite forces and moments")
+    check_force_layout(forces, force_columns, motion_time, grf_file=grf_file, settings_file=settings_file, line=line)
     return GroundReactions(forces, moments, center)
+
+
+def check_force_layout(forces: np.ndarray, force_columns: tuple[str, ...], motion_time: np.ndarray, *,
+                       grf_file: Path, settings_file: Path | None, line: int | None) -> None:
+    """:class:`InputError` when the Y (vertical) force column is not the dominant, mostly
+    positive force in the window: its peak below a horizontal column's peak magnitude, or
+    negative in most loaded frames (those above ``LOADED_FRACTION`` of the peak force)."""
+    magnitude = np.linalg.norm(forces, axis=1)
+    peak = float(magnitude.max(initial=0.0))
+    if peak <= 1e-6:
+        return  # no load in the window: nothing to tell the layout from
+    vertical = forces[:, 1]
+    loaded = magnitude > LOADED_FRACTION * peak
+    positive = float(np.mean(vertical[loaded] > 0.0))
+    horizontal = max((0, 2), key=lambda k: float(np.abs(forces[:, k]).max()))
+    horizontal_peak = float(np.abs(forces[:, horizontal]).max())
+    reasons = []
+    if positive < 0.5:
+        reasons.append(f"it is negative in {1 - positive:.0%} of the loaded frames (down to {vertical.min():.4g} N)")
+    if 0.0 < vertical.max() < horizontal_peak:
+        reasons.append(f"its peak {vertical.max():.4g} N is below the peak magnitude {horizontal_peak:.4g} N of "
+                       f"'{force_columns[horizontal]}'")
+    if not reasons:
+        return
+    found = "; ".join(reasons)
+    where = f" (named in {settings_file}{'' if line is None else f':{line}'})" if settings_file else ""
+    raise InputError(
+        f"columns {' '.join(force_columns)}{where}: the Y (vertical) column '{force_columns[1]}' is not the "
+        f"vertical ground reaction in {motion_time[0]:.6g}..{motion_time[-1]:.6g} s: {found}",
+        file=grf_file, element="<force_columns>",
+        expected="force columns ordered X, Y, Z with Y the vertical (upward) ground reaction on the foot: "
+                 "the largest force, positive while the foot is loaded")
 
 
 def full_coordinates(motion: Table, model: Model, rows: np.ndarray, body: str, *, motion_file: Path) -> np.ndarray:

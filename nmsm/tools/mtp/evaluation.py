@@ -12,7 +12,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.errors import InputError
+from nmsm.errors import InputError, SolverError
 from nmsm.model import hill
 from nmsm.tools.mtp.model import MuscleDesign, TrialModel
 from nmsm.tools.mtp.problem import MtpData, MtpState, modeled_trials
@@ -57,7 +57,7 @@ def _numeric(models: Sequence[TrialModel]) -> ModeledValues:
     per_field = {f: np.stack([arrays[t * k + i] for t in range(len(models))]) for i, f in enumerate(_FIELDS)}
     for name, arr in per_field.items():
         if not np.all(np.isfinite(arr)):
-            raise FloatingPointError(f"modeled {name} is not finite: the parameters are outside the model's range")
+            raise SolverError(f"modeled {name} is not finite: the parameters are outside the model's range")
     return ModeledValues(**per_field)
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from nmsm.errors import SolverError
 from nmsm.io.osimx import OsimxModel, OsimxMuscle, write_osimx
 from nmsm.io.storage import table_from_columns, write_storage
 from nmsm.tools.mtp.evaluation import ModeledValues
@@ -40,7 +41,7 @@ from nmsm.tools.mtp.problem import MtpData, MtpState
 
 def _write(path: Path, time: np.ndarray, labels: Sequence[str], values: np.ndarray) -> None:
     if not np.all(np.isfinite(values)):
-        raise FloatingPointError(f"refusing to write non-finite values to {path.name}")
+        raise SolverError(f"refusing to write non-finite values to {path.name}")
     path.parent.mkdir(parents=True, exist_ok=True)
     write_storage(path, table_from_columns(time, {label: values[:, i] for i, label in enumerate(labels)}, name=path.stem))
 

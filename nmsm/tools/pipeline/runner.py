@@ -12,6 +12,13 @@ For each enabled stage, in order:
    ``nmsm run`` accepts), empty the stage's folder, run the tool on that file, find its
    outputs and record the stage.
 
+Before anything is written or deleted, :class:`~nmsm.errors.InputError` refuses a results
+folder that is (or contains) the pipeline file's folder; an existing, non-empty stage folder
+the runner did not create (not in ``pipeline_state.json``): the runner empties only folders
+it wrote; and a stage folder holding an input of a stage, the pipeline file, a settings file
+or a starting input, unless it is that stage's own results read by a later stage (like a
+wired output).
+
 A stop (Ctrl-C, a failure) leaves the finished stages recorded: the next run skips them and
 redoes the stopped one. Results tree::
 
@@ -36,7 +43,7 @@ from typing import Any
 import attrs
 
 from nmsm.errors import InputError
-from nmsm.tools.pipeline.artifacts import Artifacts
+from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS, Artifacts
 from nmsm.tools.pipeline.hashing import DigestCache, code_digest
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
 from nmsm.tools.pipeline.plan import check_inputs, check_order
@@ -155,10 +162,15 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     _check_names(spec)
     check_order(spec)
     results = spec.results_directory
+    _check_results_location(spec)
     enabled = [s for s in spec.stages if s.enabled]
     check_inputs(spec, {s.name: s.load_settings() for s in enabled})
     selected = _selection(spec, only, until)
     state = PipelineState.load(results)
+    protected = input_paths(spec, results)
+    for stage in enabled:
+        if stage.name in selected:
+            _check_stage_folder(spec, stage, results, state, protected)
     forced = set(force) | ({s.name for s in spec.stages} if rebuild else set())
     cache = DigestCache(exclude=[results])
     artifacts = Artifacts()
@@ -204,6 +216,7 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
             continue
         _require_available(stage, unavailable)
         say(f"{head}: running")
+        _check_stage_folder(spec, stage, results, state, protected)
         outcome = _run_stage(stage, settings, settings_file, folder, results, digest, state, cache, wired,
                              (stage_options or {}).get(stage.name, {}))
         for artifact, path in outcome.outputs.items():
@@ -215,6 +228,85 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     if not check_only:
         (results / SUMMARY_FILE).write_text(run.summary() + "\n")
     return run
+
+
+def _check_results_location(spec: PipelineSpec) -> None:
+    """:class:`InputError` when the results folder is, or contains, the pipeline file's folder."""
+    results, home = spec.results_directory.resolve(), spec.file.parent.resolve()
+    if results == home or home.is_relative_to(results):
+        where = "the pipeline file's own folder" if results == home else "a folder containing the pipeline file"
+        raise InputError(f"the results folder {results} is {where}: the runner writes {PIPELINE_COPY}, "
+                         "<stage>.xml and one folder per stage there, among the inputs", file=spec.file,
+                         element="<results_directory>",
+                         expected="a folder of its own, e.g. <results_directory>results</results_directory>")
+
+
+def input_paths(spec: PipelineSpec, results: Path) -> dict[Path, tuple[str, int | None]]:
+    """Every path a stage reads that the runner does not rewire (resolved), the pipeline
+    file, the stage settings files and the starting inputs -> (what it is, index in
+    ``spec.stages`` of the first stage reading it; ``None``: the pipeline's own input).
+    Disabled stages count too (their settings as far as they can be read)."""
+    paths: dict[Path, tuple[str, int | None]] = {spec.file.resolve(): ("the pipeline file", None)}
+    for artifact, path in spec.inputs.items():
+        paths[path.resolve()] = (f"<{INPUT_ELEMENTS[artifact]}> of the pipeline file", None)
+    for stage in spec.stages:
+        if stage.settings_file is not None:
+            paths.setdefault(stage.settings_file.resolve(), (f"the settings file of stage '{stage.name}'", None))
+    artifacts = Artifacts()
+    for name, path in spec.inputs.items():
+        artifacts.provide(name, path, "the pipeline inputs")
+    produced: list[Path] = []  # stand-ins for the stages' outputs (files below a wired folder are outputs too)
+    for index, stage in enumerate(spec.stages):
+        try:
+            settings = stage.load_settings()
+        except InputError:
+            if stage.enabled:
+                raise
+            continue
+        wired = {f"{settings.tool_tag}/{key}" for key in wire_stage(stage.kind, settings, artifacts, stage.keep)}
+        for field in settings.path_fields():
+            if field.spec.output or field.key in wired:
+                continue
+            value = settings.resolve(field)
+            if value is not None and not any(value.resolve().is_relative_to(p) for p in produced):
+                paths.setdefault(value.resolve(), (f"<{field.spec.element}> of stage '{stage.name}'", index))
+        for artifact in stage.kind.produces if stage.enabled else ():
+            stand_in = _stage_folder(results, stage).resolve() / f".{artifact}"
+            artifacts.provide(artifact, stand_in, f"stage '{stage.name}'")
+            produced.append(stand_in)
+    return paths
+
+
+def _check_stage_folder(spec: PipelineSpec, stage: StageSpec, results: Path, state: PipelineState,
+                        protected: dict[Path, tuple[str, int | None]]) -> None:
+    """:class:`InputError` unless the runner may write the stage's settings file and empty its
+    folder: the folder is absent, empty or written by the runner, and holds no input (the
+    stage's own results read by a later stage excepted, as wired outputs are)."""
+    folder, settings_file = _stage_folder(results, stage), results / f"{stage.name}.xml"
+    own, position = folder.resolve(), spec.stages.index(stage)
+    exists = folder.exists() or folder.is_symlink()
+    is_folder = folder.is_dir() and not folder.is_symlink()
+    owned = exists and is_folder and state.owns(stage.name, _relative(folder, results))
+    for path, (what, reader) in protected.items():
+        if path == settings_file.resolve():
+            found = f"the runner writes the stage's settings to {settings_file}, which is {what}"
+        elif exists and (path == own or path.is_relative_to(own)):
+            if owned and reader is not None and reader > position:
+                continue  # this stage's results, read by a later stage
+            found = (f"its results folder {folder} holds {what} ({path}), which the runner would delete when it "
+                     "empties the folder")
+        else:
+            continue
+        raise stage.error(found, element="<Stage name>",
+                          expected="a stage name that is not the name of an input inside <results_directory>, "
+                                   "or the inputs outside the results folder")
+    if not exists or owned or (is_folder and not any(folder.iterdir())):
+        return
+    raise stage.error(f"its results folder {folder} already exists and was not written by this pipeline (not "
+                      f"recorded in {state.path}); nmsm empties only the stage folders it wrote",
+                      element="<Stage name>",
+                      expected=f"{folder} moved away or deleted by hand, another stage name or another "
+                               "<results_directory>")
 
 
 def _require_available(stage: StageSpec, unavailable: dict[str, str]) -> None:
@@ -231,8 +323,9 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
                options: dict[str, Any]) -> StageOutcome:
     state.forget(stage.name)
     if folder.exists():
-        shutil.rmtree(folder)
+        shutil.rmtree(folder)  # only a folder the runner wrote, or an empty one (_check_stage_folder)
     folder.mkdir(parents=True)
+    state.claim(stage.name, _relative(folder, results))
     settings_file.write_text(settings.text(settings_file, results))
     began = time.perf_counter()
     result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})

@@ -8,10 +8,14 @@ stage's tool returned and its outputs were found::
                         "settings_file": "mtp.xml", "results_directory": "mtp",
                         "input_digest": "<sha256>", "outputs": {"osimx": "mtp/model_mtp.osimx", ...},
                         "output_digest": "<sha256>", "finished": "2025-01-01T12:00:00",
-                        "wall_time": 12.5}}}
+                        "wall_time": 12.5}},
+     "stage_folders": {"mtp": "mtp"}}
 
 Paths in records are relative to the results directory (the tree can be moved). A stage
 stopped half-way has no record, so the next run redoes it and nothing after it.
+``stage_folders`` lists the stage folders the runner created (saved before the stage's tool
+runs): the runner empties only those (or a folder of a recorded stage), never a folder it
+did not write. A file without it (older nmsm) reads as none created.
 
 A file of another format version, or a record missing a field, is an
 :class:`~nmsm.errors.InputError` naming the file, the stage and the missing piece.
@@ -71,10 +75,12 @@ class PipelineState:
     """The records of a results directory; :meth:`save` rewrites the file atomically."""
 
     def __init__(self, results_directory: Path, records: dict[str, StageRecord] | None = None,
-                 nmsm_version: str = "") -> None:
+                 nmsm_version: str = "", folders: dict[str, str] | None = None) -> None:
         self.results_directory = Path(results_directory)
         self.records: dict[str, StageRecord] = dict(records or {})
         self.nmsm_version = nmsm_version
+        #: stage name -> folder (relative to the results directory) the runner created for it
+        self.folders: dict[str, str] = dict(folders or {})
 
     @property
     def path(self) -> Path:
@@ -113,7 +119,16 @@ class PipelineState:
                 raise _stale_error(path, f"stage '{name}': record lacks {', '.join(missing)}",
                                    "every stage record with " + ", ".join(_RECORD_FIELDS))
             records[name] = StageRecord(name=name, **{f: raw[f] for f in _RECORD_FIELDS})
-        return cls(results_directory, records, str(data.get("nmsm_version", "")))
+        folders = data.get("stage_folders", {})
+        if not isinstance(folders, dict) or not all(isinstance(v, str) for v in folders.values()):
+            raise _stale_error(path, "\"stage_folders\" is not a table of folder names",
+                               "a \"stage_folders\" object of stage name: folder")
+        return cls(results_directory, records, str(data.get("nmsm_version", "")), folders)
+
+    def owns(self, name: str, folder: str) -> bool:
+        """Whether the runner created ``folder`` (relative) for stage ``name`` or recorded it."""
+        record = self.records.get(name)
+        return self.folders.get(name) == folder or (record is not None and record.results_directory == folder)
 
     # ---- writing -----------------------------------------------------------------------
     def record(self, record: StageRecord) -> None:
@@ -126,6 +141,11 @@ class PipelineState:
         if self.records.pop(name, None) is not None:
             self.save()
 
+    def claim(self, name: str, folder: str) -> None:
+        """Note that the runner created ``folder`` (relative) for stage ``name``; save the file."""
+        self.folders[name] = folder
+        self.save()
+
     def save(self) -> None:
         from nmsm import __version__
 
@@ -135,6 +155,7 @@ class PipelineState:
             "version": VERSION,
             "nmsm_version": __version__,
             "stages": {name: rec.to_json() for name, rec in self.records.items()},
+            "stage_folders": dict(self.folders),
         }
         handle, temporary = tempfile.mkstemp(prefix=".state-", dir=self.results_directory)
         try:

@@ -12,16 +12,20 @@ Options (keyword arguments) are the fields of
 (return the cost of the starting point without solving) and ``write_results``.
 
 Results are staged and moved into the results folder only when the solve succeeded. A
-failed solve writes its last iterate and a diagnosis into ``<results>/last_iterate/`` and
-raises :class:`~nmsm.errors.SolverError`. A results folder that is one of the input folders
-(tracked quantities, initial guess, guess) is refused before solving, and the input data files
-are never overwritten.
+failed solve writes its last iterate and a diagnosis into ``<results>/last_iterate/``, moves
+the results an earlier run wrote there for the same trial into ``<results>/superseded/``
+(:meth:`~nmsm.core.results.ResultsDirectory.retire`) and raises
+:class:`~nmsm.errors.SolverError`. The IPOPT log is removed from the results folder however
+the run ends (a copy goes with the results or the last iterate). A results folder that is
+one of the input folders (tracked quantities, initial guess, guess) is refused before
+solving, and the input data files are never overwritten.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -29,7 +33,7 @@ from typing import Any
 import attrs
 
 from nmsm.core.problem import Solution
-from nmsm.core.results import ResultsDirectory
+from nmsm.core.results import SUPERSEDED, ResultsDirectory
 from nmsm.errors import InputError, SolverError
 from nmsm.tools.treatment.diagnosis import convergence_summary
 from nmsm.tools.treatment.solution import TreatmentSolution
@@ -204,19 +208,34 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
         _check_results_apart(settings, opts, prepared)
         results = _results_directory(settings, opts, [Path(path), Path(settings.input_model_file),
                                                       *_input_files(prepared)])
-    log_dir = Path(results.path) / ".ipopt" if results is not None else None
-    if log_dir is not None:
-        log_dir.mkdir(parents=True, exist_ok=True)
+    # the IPOPT log is written into a hidden folder of this run, removed however the run ends
+    log_dir = Path(tempfile.mkdtemp(prefix=".ipopt-", dir=results.path)) if results is not None else None
+    try:
+        return _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
+    finally:
+        if log_dir is not None:
+            shutil.rmtree(log_dir, ignore_errors=True)
+
+
+def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prepared, opts: TreatmentOptions,
+                     results: ResultsDirectory | None, log_dir: Path | None, initial_cost: float,
+                     build_time: float) -> TreatmentRun:
+    """Solve; write the results (recorded under the trial name), or on failure the last
+    iterate, after moving the earlier run's results of the trial into ``superseded/``."""
+    trial = settings.trial_name
     log = log_dir / f"{trial}_ipopt.log" if log_dir is not None else None
-    solution = problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
+    solution = prepared.built.problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
     tsol = TreatmentSolution(prepared.built, solution, trial)
     summary = convergence_summary(prepared.built, solution)
     files: list[Path] = []
     if not solution.success:
-        saved = None
+        saved, note = None, ""
         if results is not None:
             from nmsm.tools.treatment.outputs import write_solution
 
+            if results.retire(trial):
+                note = (f"; the results an earlier run wrote for trial '{trial}' were moved to "
+                        f"{Path(results.path) / SUPERSEDED}")
             with results.task("last_iterate") as stage:
                 target = stage / "last_iterate"
                 write_solution(target, tsol, summary=summary)
@@ -225,20 +244,18 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
                     shutil.copy2(log, target / log.name)
             saved = str(Path(results.path) / "last_iterate")
         raise SolverError(f"{settings.settings_file}: IPOPT did not converge ({solution.status} after "
-                          f"{solution.iterations} iterations)", last_iterate_path=saved)
+                          f"{solution.iterations} iterations){note}", last_iterate_path=saved)
     if results is not None:
         from nmsm.tools.treatment.design import parameter_tables, write_parameter_solution
         from nmsm.tools.treatment.outputs import write_solution
 
-        with results.task(trial) as stage:
+        with results.task(trial, record=trial) as stage:
             files = write_solution(stage, tsol, summary=summary, extra_tables=parameter_tables(prepared, tsol))
             files += write_parameter_solution(stage, prepared, tsol)
             shutil.copy2(path, stage / Path(path).name)
             if log is not None and log.is_file():
                 shutil.copy2(log, stage / log.name)
         files = [Path(results.path) / f.relative_to(stage) for f in files]
-        if log_dir is not None:
-            shutil.rmtree(log_dir, ignore_errors=True)
     return TreatmentRun(prepared, solution, tsol, summary, initial_cost, Path(results.path) if results else None,
                         files, build_time)
 

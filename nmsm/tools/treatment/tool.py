@@ -235,9 +235,14 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     guess_table = guess_files.results.get("states", guess_files.initial_ik)
     t_guess = duration(guess_table)
     final_range = getattr(settings, "final_time_range", None)
+    problems: list[str] = []
     if final_range:
         lo_t, hi_t = float(final_range[0]), float(final_range[1])
         tf_guess = float(np.clip(t_guess, lo_t, hi_t))
+        if tf_guess != t_guess:
+            source = Path(getattr(guess_table, "source", None) or "the initial guess").name
+            problems.append(f"final time <final_time_range>: initial guess {t_guess:.6g} s (duration of {source}) "
+                            f"outside the bounds [{lo_t:.6g}, {hi_t:.6g}]")
     else:
         lo_t = hi_t = tf_guess = t_ref
         t_guess = t_ref if options.guess_directory is None else t_guess
@@ -258,7 +263,7 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
                          controllers=controllers, contact_models=_contact_models(tool, setup),
                          rescale_prescribed_derivatives=options.rescale_prescribed_derivatives)
     state_setup = _state_setup(settings, files, guess_files, states, refs, plan, t_guess)
-    problems = check_guess_within("state", tuple(states) + tuple(speed_label(c) for c in states),
+    problems += check_guess_within("state", tuple(states) + tuple(speed_label(c) for c in states),
                                   state_setup.guess, state_setup.lower, state_setup.upper)
     problems += check_guess_within("acceleration", states, state_setup.accel_guess, state_setup.accel_lower,
                                    state_setup.accel_upper)

@@ -115,3 +115,30 @@ def test_read_only_results_folder_fails_before_optimizing(case):
         assert time.perf_counter() - start < 5.0
     finally:
         os.chmod(case / "results", 0o755)
+
+
+def test_force_columns_in_the_wrong_layout(case):
+    """Vertical and fore-aft columns swapped in <force_columns>: the Y column is not the vertical force."""
+    with pytest.raises(InputError, match="below the peak magnitude") as err:
+        _load(case, **{"<force_columns>f1_vx f1_vy f1_vz": "<force_columns>f1_vy f1_vx f1_vz"})
+    message = str(err.value)
+    assert "grf.sto" in message and "<force_columns>" in message and "settings.xml" in message
+    assert "Y (vertical) column 'f1_vx'" in message and "'f1_vy'" in message
+    assert "expected force columns ordered X, Y, Z with Y the vertical (upward)" in message
+
+
+def _rewrite_forces(path, **scale):
+    grf = read_storage(path)
+    columns = {k: grf.column(k) * scale.get(k, 1.0) for k in grf.labels}
+    write_storage(path, table_from_columns(grf.time, columns, name="grf"))
+
+
+def test_vertical_force_with_the_wrong_sign(case):
+    """A plate reporting the force on the plate (vertical negative) is refused, naming the column."""
+    _rewrite_forces(case / "grf.sto", f1_vy=-1.0)
+    with pytest.raises(InputError, match=r"Y \(vertical\) column 'f1_vy' is not the vertical") as err:
+        _load(case)
+    assert "grf.sto" in str(err.value)
+    _rewrite_forces(case / "grf.sto", f1_vx=0.0, f1_vz=0.0)  # no horizontal force to compare with: the sign decides
+    with pytest.raises(InputError, match="'f1_vy' is not the vertical.*negative in 100% of the loaded frames"):
+        _load(case)

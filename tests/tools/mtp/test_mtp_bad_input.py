@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import types
 import warnings
 from pathlib import Path
 
@@ -147,3 +148,27 @@ def test_tiny_tendon_slack_length_gives_finite_results(case):
     assert np.isfinite(outcome.tasks[0].cost)
     for path in (folder / "results").rglob("*.sto"):
         assert np.all(np.isfinite(read_storage(path).data)), path.name
+
+
+def test_non_finite_modeled_values_raise_an_nmsm_error():
+    """A non-finite modeled value is a SolverError (an nmsm error the CLI reports), not FloatingPointError."""
+    import casadi as cs
+
+    from nmsm.errors import NmsmError, SolverError
+    from nmsm.tools.mtp.evaluation import _FIELDS, _numeric
+
+    values = {name: cs.MX(cs.DM(np.ones((3, 2)))) for name in _FIELDS}
+    values["tendon_force"] = cs.MX(cs.DM(np.array([[1.0, np.nan], [1.0, 1.0], [1.0, 1.0]])))
+    with pytest.raises(SolverError, match="modeled tendon_force is not finite") as info:
+        _numeric([types.SimpleNamespace(**values)])
+    assert isinstance(info.value, NmsmError)
+
+
+def test_non_finite_values_are_not_written(tmp_path):
+    from nmsm.errors import SolverError
+    from nmsm.tools.mtp.outputs import _write
+
+    path = tmp_path / "Analysis" / "gait_1_tendonForces.sto"
+    with pytest.raises(SolverError, match="refusing to write non-finite values to gait_1_tendonForces.sto"):
+        _write(path, np.array([0.0, 0.01]), ["soleus_r"], np.array([[1.0], [np.inf]]))
+    assert not path.exists()

@@ -203,3 +203,58 @@ def test_unknown_stage_tool_and_duplicate_names(case: Path) -> None:
     (case / "maker.xml").write_text(MAKER_SETTINGS.format(offset=0))
     with pytest.raises(InputError, match="stage name 'a' used twice"):
         run_pipeline_file(path, log=None)
+
+
+def test_stage_folder_the_runner_did_not_write_is_never_emptied(case: Path) -> None:
+    """A results tree without pipeline_state.json (an older run, another tool) keeps its files."""
+    pipeline = _pipeline(case)
+    old = case / "results" / "make" / "old_result.osim"
+    old.parent.mkdir(parents=True)
+    old.write_text("old")
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(pipeline, log=None)
+    text = str(info.value)
+    assert "stage 'make'" in text and str(old.parent) in text and "not written by this pipeline" in text
+    assert old.read_text() == "old" and CALLS == []
+    assert not (case / "results" / STATE_FILE).exists() and not (case / "results" / "pipeline.xml").exists()
+    old.unlink()  # an empty folder is used as it is
+    assert _statuses(run_pipeline_file(pipeline, log=None)) == {"make": RAN, "fit": RAN}
+
+
+def test_stage_folder_holding_an_input_is_refused(case: Path) -> None:
+    # a stage named like an input folder inside the results folder
+    data = case / "res" / "data"
+    data.mkdir(parents=True)
+    (data / "trial_1.sto").write_text("INPUT\n")
+    pipeline = _pipeline(case, fitter_data="res/data")
+    pipeline.write_text(pipeline.read_text().replace("<results_directory>results<", "<results_directory>res<")
+                        .replace('name="make"', 'name="data"'))
+    with pytest.raises(InputError, match=r"stage 'data' \(maker\): its results folder .*res/data holds "
+                                         r"<data_directory> of stage 'fit'"):
+        run_pipeline_file(pipeline, log=None)
+    assert (data / "trial_1.sto").read_text() == "INPUT\n" and CALLS == []
+    # a stage's own results read by a later stage are outputs (as if wired): the stage reruns
+    run_pipeline_file(_pipeline(case), log=None)
+    made = case / "results" / "make" / "made.osim"
+    run = run_pipeline_file(_pipeline(case, offset="2", fitter_data="results/make"), log=None)
+    assert _statuses(run) == {"make": RAN, "fit": RAN}
+    assert "made.osim" in (case / "results" / "fit" / "fit_mtp.osimx").read_text()
+    # but a stage reading its own results folder would lose its input: refused, even though the runner wrote it
+    pipeline = _pipeline(case, offset="3")
+    (case / "maker.xml").write_text((case / "maker.xml").read_text().replace("<input_model_file>model.osim<",
+                                                                             f"<input_model_file>{made}<"))
+    with pytest.raises(InputError, match=r"stage 'make' \(maker\): its results folder .* holds <input_model_file> "
+                                         r"of stage 'make'"):
+        run_pipeline_file(pipeline, log=None)
+    assert made.read_text() == "<model/>\n<!-- offset 2 -->\n"
+
+
+def test_results_directory_of_the_pipeline_folder_is_refused(case: Path) -> None:
+    pipeline = _pipeline(case)
+    text = pipeline.read_text().replace("<results_directory>results<", "<results_directory>.<")
+    pipeline.write_text(text)
+    before = sorted(p.name for p in case.iterdir())
+    with pytest.raises(InputError, match=r"pipeline.xml: <results_directory>: the results folder .* is the pipeline "
+                                         r"file's own folder.*\(expected a folder of its own"):
+        run_pipeline_file(pipeline, log=None)
+    assert sorted(p.name for p in case.iterdir()) == before and pipeline.read_text() == text

@@ -118,6 +118,24 @@ def test_initial_guess_outside_the_bounds_is_reported(shared_data: Path, tmp_pat
     assert np.all(run.solution.x_scaled >= lo) and np.all(run.solution.x_scaled <= hi)
 
 
+
+def test_final_time_guess_outside_the_range_is_reported(shared_data: Path, tmp_path: Path) -> None:
+    path = _settings(shared_data, tmp_path, tool="DesignOptimizationTool")
+    text = path.read_text()
+    path.write_text(text.replace("<RCNLCostTermSet>", "<final_time_range>3 4</final_time_range><RCNLCostTermSet>"))
+    with pytest.warns(UserWarning, match=r"initial guess violates variable bounds.*\n.*final time <final_time_range>: "
+                                         r"initial guess 0.31 s \(duration of drive_kick1.sto\) outside the bounds "
+                                         r"\[3, 4\]"):
+        run = run_settings(path, evaluate_only=True)
+    assert run.prepared.data.final_time_guess == 3.0  # IPOPT starts from the projection
+    path.write_text(text.replace("<RCNLCostTermSet>", "<final_time_range>0.2 0.4</final_time_range><RCNLCostTermSet>"))
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run = run_settings(path, evaluate_only=True)
+    assert not any("final time" in str(w.message) for w in record)
+    assert run.prepared.data.final_time_guess == pytest.approx(0.31)
+
+
 INFEASIBLE = ("<RCNLConstraintTerm><is_enabled>true</is_enabled><type>generalized_coordinate_value</type>"
               "<coordinate_list>knee_angle_r</coordinate_list><max_error>6</max_error><min_error>5</min_error>"
               "</RCNLConstraintTerm></RCNLConstraintTermSet>")
@@ -162,3 +180,23 @@ def test_results_folder_cannot_be_an_input_folder(shared_data: Path, tmp_path: P
         _quiet_run(toy / "verification_optimization" / "TorqueDrivenVOSettings.xml", results_directory=to,
                    initial_guess_directory=to, tracked_quantities_directory=to, print_level=0)
     assert (to / "arm1_states.sto").read_bytes() == before
+
+
+def test_failed_rerun_leaves_no_earlier_result_looking_like_its_own(shared_data: Path, tmp_path: Path) -> None:
+    settings = shared_data / "treatment" / "toy_arm" / "tracking_optimization" / "TorqueDrivenTOSettings.xml"
+    to = tmp_path / "to"
+    _quiet_run(settings, results_directory=to, print_level=0)
+    written = sorted(p.relative_to(to) for p in to.rglob("*") if p.is_file() and not p.name.startswith("."))
+    assert Path("arm1_states.sto") in written and Path("arm1_ipopt.log") in written
+    (to / "notes.txt").write_text("the user's")
+    with pytest.raises(SolverError, match=r"did not converge.*earlier run wrote for trial 'arm1' were moved to "
+                                          r".*superseded") as info:
+        _quiet_run(settings, results_directory=to, print_level=0, max_iterations=1)
+    assert Path(info.value.last_iterate_path) == to / "last_iterate"
+    # nothing of the earlier run at the top level, no half-written IPOPT log, the user's file kept
+    assert sorted(p.name for p in to.iterdir()) == ["last_iterate", "notes.txt", "superseded"]
+    assert (to / "notes.txt").read_text() == "the user's"
+    assert sorted(p.relative_to(to / "superseded") for p in (to / "superseded").rglob("*")
+                  if p.is_file() and not p.name.startswith(".")) == written
+    assert "Solve_Succeeded" in (to / "superseded" / "arm1_convergence.txt").read_text()
+    assert "Maximum_Iterations_Exceeded" in (to / "last_iterate" / "arm1_convergence.txt").read_text()
