@@ -10,6 +10,9 @@
     subject/gait.trc                 markers of the simulated gait (100 Hz, mm)
     subject/gait_grf.mot, .xml       its ground reactions (1000 Hz) and their ExternalLoads
     subject/gait_emg.mot             raw EMG of the eight channels (1000 Hz, mV, -0.3-1.2 s)
+    subject/passive/<trial>.trc      passive trials (MTLI): markers of slow sweeps of the
+    subject/passive/<trial>_moments.sto   relaxed leg and the joint moments (N m) a
+                                     dynamometer measures (:mod:`nmsm.examples.subject_passive`)
     truth/true.osim                  the subject's true model
     truth/true_contact.osimx         the true foot springs
     truth/truth.json                 every known parameter (:func:`read_truth`)
@@ -66,6 +69,15 @@ class Subject:
     emg_file: Path
     truth_file: Path
     true_contact: Path
+    passive_folder: Path
+
+    @property
+    def passive_trials(self) -> list[tuple[str, Path, Path]]:
+        """``(name, markers .trc, moments .sto)`` of each passive trial."""
+        from nmsm.examples.subject_passive import PASSIVE_TRIALS
+
+        return [(name, self.passive_folder / f"{name}.trc", self.passive_folder / f"{name}_moments.sto")
+                for name in PASSIVE_TRIALS]
 
     @property
     def truth(self) -> dict[str, Any]:
@@ -81,8 +93,9 @@ def subject_in(folder: str | os.PathLike[str]) -> Subject | None:
                       calibration_markers=inputs / "calibration" / "markers.trc", gait_markers=inputs / f"{TRIAL}.trc",
                       grf_file=inputs / f"{TRIAL}_grf.mot", external_loads=inputs / f"{TRIAL}_grf.xml",
                       emg_file=inputs / f"{TRIAL}_emg.mot", truth_file=truth / "truth.json",
-                      true_contact=truth / "true_contact.osimx")
-    paths = [getattr(subject, f.name) for f in attrs.fields(Subject) if f.name != "folder"]
+                      true_contact=truth / "true_contact.osimx", passive_folder=inputs / "passive")
+    paths = [getattr(subject, f.name) for f in attrs.fields(Subject) if f.name not in ("folder", "passive_folder")]
+    paths += [p for _, markers, moments in subject.passive_trials for p in (markers, moments)]
     return subject if all(Path(p).is_file() for p in paths) else None
 
 
@@ -123,6 +136,25 @@ def effective_emg_scales(emg_time: np.ndarray, raw: np.ndarray, time: np.ndarray
         recorded = np.interp(time[window] - delay, emg_time, envelope[:, k])
         out.append(float(recorded @ excitation[window, k] / (recorded @ recorded)))
     return out
+
+
+def _write_passive_trials(folder: Path, model, casadi_model, muscles) -> Path:
+    """Markers (100 Hz) and measured joint moments of each passive trial, on the true model."""
+    from nmsm.examples.subject_data import marker_table
+    from nmsm.examples.subject_passive import PASSIVE_DURATION, PASSIVE_TRIALS, passive_moments, passive_poses
+    from nmsm.io.storage import table_from_columns, write_storage
+    from nmsm.io.trc import write_trc
+
+    folder.mkdir(parents=True, exist_ok=True)
+    time = np.round(np.arange(0.0, PASSIVE_DURATION + 1e-9, 1.0 / MARKER_RATE), 9)
+    for name in PASSIVE_TRIALS:
+        q = passive_poses(model.coordinate_names, name, time, sm.STANDING_HEIGHT)
+        write_trc(folder / f"{name}.trc", marker_table(casadi_model, model.marker_names, time, q), units="mm")
+        moments = passive_moments(model, muscles, q)
+        write_storage(folder / f"{name}_moments.sto",
+                      table_from_columns(time, {f"{c}_moment": moments[:, k] for k, c in enumerate(sm.MUSCLE_COORDINATES)},
+                                         name="passive joint moments (N m)"))
+    return folder
 
 
 def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> Subject:
@@ -219,6 +251,9 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
     jmp_case = make_synthetic_jmp_case(inputs / "calibration", model_file=true_model, knee="knee_r", ankle="ankle_r",
                                        seed=seed, duration=2.0)
 
+    say("writing the passive trials for MTLI")
+    passive_folder = _write_passive_trials(inputs / "passive", model, cm, muscles)
+
     # truth
     np.savez_compressed(truth_dir / "simulation.npz", time=simulation.time, q=simulation.q, u=simulation.u,
                         udot=simulation.udot, a=simulation.a, c=simulation.c, e=excitation, force=simulation.force,
@@ -245,4 +280,4 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
     return Subject(folder=folder, generic_model=generic_model, true_model=true_model,
                    calibration_settings=jmp_case.settings_file, calibration_markers=jmp_case.marker_file,
                    gait_markers=gait_markers, grf_file=grf_file, external_loads=external_loads, emg_file=emg_file,
-                   truth_file=truth_file, true_contact=true_contact)
+                   truth_file=truth_file, true_contact=true_contact, passive_folder=passive_folder)

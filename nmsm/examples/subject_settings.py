@@ -1,8 +1,9 @@
 """The pipeline file of the built-in example (``nmsm example``) for a generated subject.
 
 :func:`write_example_pipeline` writes ``<folder>/pipeline.xml``: JMP from the subject's
-range-of-motion settings file, then every other stage embedded (the analysis of the gait
-trial on the personalized model, preprocessing, MTP, NCP, GCP, surrogate data, and the
+range-of-motion settings file, then every other stage embedded (the analyses of the passive
+trials and of the gait trial on the personalized model, preprocessing, MTP with MTLI, NCP,
+GCP, surrogate data, and the
 treatment stages TO, VO, DO with their solver file ``<folder>/settings/solver.xml``).
 Paths are relative to the pipeline file; inputs the runner rewires (model, osimx, data
 folders) name the subject's own files so each embedded block also reads on its own.
@@ -17,7 +18,7 @@ from nmsm.examples import subject_model as sm
 from nmsm.examples.subject import EMG_LOW_PASS, GCP_WINDOW, GRF_NAME, SIMULATION, TRIAL, TRIAL_WINDOW, Subject
 
 #: the stages of the example, in order (``nmsm example <stage>`` runs up to one of them)
-STAGES = ("jmp", "analysis", "preprocess", "mtp", "ncp", "gcp", "surrogate", "to", "vo", "do")
+STAGES = ("jmp", "passive", "analysis", "preprocess", "mtp", "ncp", "gcp", "surrogate", "to", "vo", "do")
 PREPROCESSED_TRIAL = f"{TRIAL}_1"
 #: EMG padding (s) before and after the trial: the padded EMG starts at -0.14 s, before the
 #: simulation, where the recorded excitations are constant. MTP samples the EMG spline at
@@ -64,6 +65,25 @@ def analysis_xml(subject: Subject, folder: Path) -> str:
       </ModelAnalysisTool>"""
 
 
+def passive_xml(subject: Subject, folder: Path) -> str:
+    """IK and muscle analysis of the passive trials on the personalized model; their joint
+    moments are the measured ones (MTLI's passive data: ``results/passive``)."""
+    r = lambda p: _relative(p, folder)  # noqa: E731
+    trials = "".join(f"""
+          <Trial name="{name}">
+            <marker_file>{r(markers)}</marker_file>
+            <inverse_dynamics_file>{r(moments)}</inverse_dynamics_file>
+          </Trial>""" for name, markers, moments in subject.passive_trials)
+    return f"""<ModelAnalysisTool>
+        <results_directory>passive</results_directory>
+        <input_model_file>{r(subject.generic_model)}</input_model_file>
+        <TrialSet>{trials}
+        </TrialSet>
+        <accuracy>1e-8</accuracy>
+        <muscle_analysis_coordinate_list>{" ".join(sm.MUSCLE_COORDINATES)}</muscle_analysis_coordinate_list>
+      </ModelAnalysisTool>"""
+
+
 def preprocess_xml(subject: Subject, folder: Path) -> str:
     return f"""<DataPreprocessingTool>
         <results_directory>preprocessed</results_directory>
@@ -78,6 +98,11 @@ def preprocess_xml(subject: Subject, folder: Path) -> str:
 
 
 def mtp_xml(subject: Subject, folder: Path) -> str:
+    """MTLI fits the optimal fiber and tendon slack lengths to the passive trials; the MTP
+    tasks then keep them and personalize delays, time constants, EMG scales and
+    nonlinearities. (With the lengths free, one gait trial's moments trade them off against
+    the EMG scales: lengths 5-32 % off the truth and activations 0.039 RMS from it, against
+    0.022 with MTLI's lengths; docs/pipeline.md.)"""
     channels = " ".join(spec.channel for spec in sm.MUSCLES.values())
     terms = _term("inverse_dynamics_joint_moment", 1.0)
     return f"""<MuscleTendonPersonalizationTool>
@@ -89,7 +114,13 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
         <activation_muscle_groups/>
         <normalized_fiber_length_muscle_groups/>
         <collected_emg_channel_muscle_groups>{channels}</collected_emg_channel_muscle_groups>
-        <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
+        <MuscleTendonLengthInitialization>
+          <is_enabled>true</is_enabled>
+          <passive_data_input_directory>results/passive</passive_data_input_directory>
+          <optimize_maximum_muscle_stress>false</optimize_maximum_muscle_stress>
+          <optimize_isometric_max_force>false</optimize_isometric_max_force>
+          <RCNLCostTermSet>{_term("passive_joint_moment", 1.0)}</RCNLCostTermSet>
+        </MuscleTendonLengthInitialization>
         <MTPSynergyExtrapolation><is_enabled>false</is_enabled></MTPSynergyExtrapolation>
         <MTPTaskList>
           <MTPTask>
@@ -103,6 +134,8 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
           <MTPTask>
             <is_enabled>true</is_enabled><index>2</index>
             <muscle_specific_electromechanical_delays>true</muscle_specific_electromechanical_delays>
+            <optimize_optimal_fiber_lengths>false</optimize_optimal_fiber_lengths>
+            <optimize_tendon_slack_lengths>false</optimize_tendon_slack_lengths>
             <RCNLCostTermSet>{terms}</RCNLCostTermSet>
           </MTPTask>
         </MTPTaskList>
@@ -120,7 +153,13 @@ def ncp_xml(subject: Subject, folder: Path, n_synergies: int) -> str:
         <coordinate_list>{" ".join(sm.MUSCLE_COORDINATES)}</coordinate_list>
         <activation_muscle_groups/>
         <normalized_fiber_length_muscle_groups/>
-        <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
+        <MuscleTendonLengthInitialization>
+          <is_enabled>true</is_enabled>
+          <passive_data_input_directory>results/passive</passive_data_input_directory>
+          <optimize_maximum_muscle_stress>false</optimize_maximum_muscle_stress>
+          <optimize_isometric_max_force>false</optimize_isometric_max_force>
+          <RCNLCostTermSet>{_term("passive_joint_moment", 1.0)}</RCNLCostTermSet>
+        </MuscleTendonLengthInitialization>
         <mtp_results_directory>results/mtp</mtp_results_directory>
         <RCNLCostTermSet>{terms}</RCNLCostTermSet>
         <RCNLSynergySet>
@@ -243,6 +282,15 @@ def _consistency() -> str:
     return _constraint("kinetic_consistency", -1.0, 1.0, load_list=loads)
 
 
+def _initial_state() -> str:
+    """The TO's (VO's) initial state: VO and DO start where the motion they verify or change
+    starts. Without it, controller tracking alone leaves the start free and the kinetic
+    consistency band lets IPOPT settle anywhere on a flat objective."""
+    coordinates = " ".join(sm.MUSCLE_COORDINATES)
+    return (_constraint("initial_generalized_coordinate_deviation", -1e-3, 1e-3, coordinate_list=coordinates)
+            + _constraint("initial_generalized_speed_deviation", -1e-2, 1e-2, coordinate_list=coordinates))
+
+
 def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -> str:
     """``to``, ``vo`` or ``do`` settings of the example (synergy-driven, foot springs from GCP)."""
     coordinates = " ".join(sm.MUSCLE_COORDINATES)
@@ -267,7 +315,7 @@ def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -
         {common}
         {_synergy_controller(False)}
         <RCNLCostTermSet>{_term("controller_tracking", 1.0, controller_list=synergies)}</RCNLCostTermSet>
-        <RCNLConstraintTermSet>{_consistency()}</RCNLConstraintTermSet>
+        <RCNLConstraintTermSet>{_consistency()}{_initial_state()}</RCNLConstraintTermSet>
       </VerificationOptimizationTool>"""
     common = _treatment_common(subject, folder, "do", "results/vo", "results/vo")
     strength = PLANTARFLEXOR_STRENGTH
@@ -281,7 +329,7 @@ def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -
           <initial_values>{strength:g}</initial_values><lower_bounds>{strength:g}</lower_bounds>
           <upper_bounds>{strength:g}</upper_bounds></RCNLParameterTerm></RCNLParameterTermSet>
         <RCNLCostTermSet>{costs}</RCNLCostTermSet>
-        <RCNLConstraintTermSet>{_consistency()}</RCNLConstraintTermSet>
+        <RCNLConstraintTermSet>{_consistency()}{_initial_state()}</RCNLConstraintTermSet>
       </DesignOptimizationTool>"""
 
 
@@ -290,6 +338,7 @@ def stage_blocks(subject: Subject, folder: Path, n_synergies: int) -> dict[str, 
     jmp = _relative(subject.calibration_settings, folder)
     blocks = {
         "jmp": f"<settings_file>{jmp}</settings_file>",
+        "passive": passive_xml(subject, folder),
         "analysis": analysis_xml(subject, folder),
         "preprocess": preprocess_xml(subject, folder),
         "mtp": mtp_xml(subject, folder),

@@ -7,7 +7,9 @@ After Joint Model Personalization the model changed, so the pipeline re-runs, pe
    ``IKData/<trial>.sto`` (OpenSim motion, rotational coordinates in degrees) and
    ``IKErrors/<trial>.sto`` (marker distance errors, m);
 2. inverse dynamics with the trial's ground reactions
-   (:func:`nmsm.model.id_tool.inverse_dynamics_of_motion`) -> ``IDData/<trial>.sto``;
+   (:func:`nmsm.model.id_tool.inverse_dynamics_of_motion`) -> ``IDData/<trial>.sto``, or the
+   trial's measured joint moments (``<inverse_dynamics_file>``, e.g. a dynamometer in a
+   passive trial) checked against the IK frames (:func:`measured_moments`);
 3. muscle analysis (:func:`nmsm.model.muscle_analysis.analyze_motion`; OpenSim through the
    bridge only for muscles with active wrapping) -> ``MAData/<trial>/...``;
 4. copies of the ground reactions and raw EMG -> ``GRFData/<trial>.sto``,
@@ -57,6 +59,22 @@ def read_settings(path: str | os.PathLike[str]) -> ModelAnalysisSettings:
     return read_native_settings(path, ModelAnalysisSettings, TOOL)
 
 
+def measured_moments(path: Path, time: np.ndarray) -> Any:
+    """The table of ``path`` (joint moments, N m) if it is sampled at the IK frames ``time``
+    (s, within 1e-6 s), else an :class:`~nmsm.errors.InputError` naming the file."""
+    from nmsm.errors import InputError
+    from nmsm.io.storage import read_storage
+
+    table = read_storage(path)
+    inside = (table.time >= time[0] - 1e-6) & (table.time <= time[-1] + 1e-6)
+    rows = table.time[inside]
+    if rows.size != time.size or not np.allclose(rows, time, rtol=0.0, atol=1e-6):
+        raise InputError(
+            f"{rows.size} rows in {time[0]:g}-{time[-1]:g} s, the markers give {time.size} frames",
+            file=path, expected="joint moments at the marker frames of the trial")
+    return attrs.evolve(table, time=rows, data=table.data[inside])
+
+
 def _analyse(settings: ModelAnalysisSettings, trial: AnalysisTrial, model: Any, stage: Path) -> TrialAnalysis:
     from nmsm.io.storage import read_storage, write_storage
     from nmsm.model.external_loads import read_external_loads
@@ -77,8 +95,11 @@ def _analyse(settings: ModelAnalysisSettings, trial: AnalysisTrial, model: Any, 
         loads = attrs.evolve(read_external_loads(trial.external_loads_file), data_file=trial.grf_file)
         shutil.copyfile(trial.grf_file, stage / "GRFData" / f"{trial.name}.sto")
     cutoff = settings.id_lowpass_cutoff_frequency
-    moments = inverse_dynamics_of_motion(model, read_storage(stage / "IKData" / f"{trial.name}.sto"),
-                                         external_loads=loads, lowpass_hz=cutoff if cutoff > 0 else None)
+    if trial.inverse_dynamics_file is not None:
+        moments = measured_moments(trial.inverse_dynamics_file, motion.time)
+    else:
+        moments = inverse_dynamics_of_motion(model, read_storage(stage / "IKData" / f"{trial.name}.sto"),
+                                             external_loads=loads, lowpass_hz=cutoff if cutoff > 0 else None)
     write_storage(stage / "IDData" / f"{trial.name}.sto", moments, name="Inverse Dynamics")
     ma_cutoff = settings.muscle_analysis_lowpass_cutoff_frequency
     if model.muscles:
@@ -102,7 +123,9 @@ def run_settings(settings_file: str | os.PathLike[str], *, results_directory: st
     settings = read_settings(settings_file)
     if results_directory is not None:
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
-    inputs = [settings.input_model_file, *(t.marker_file for t in settings.trials)]
+    inputs = [settings.input_model_file, *(path for t in settings.trials for path in
+                                            (t.marker_file, t.inverse_dynamics_file, t.grf_file, t.emg_file)
+                                            if path is not None)]
     results = ResultsDirectory(settings.results_directory, inputs=inputs)
     model = load_model(settings.input_model_file)
     done = []

@@ -15,6 +15,10 @@ dynamics and muscle analysis of recorded trials on the current model.
           <emg_file>gait_emg.mot</emg_file>            <!-- optional: copied for preprocessing -->
           <time_range>0 1.4</time_range>               <!-- optional -->
         </Trial>
+        <Trial name="passive_knee">
+          <marker_file>passive_knee.trc</marker_file>
+          <inverse_dynamics_file>passive_knee_moments.sto</inverse_dynamics_file>  <!-- measured moments -->
+        </Trial>
       </TrialSet>
       <id_lowpass_cutoff_frequency>-1</id_lowpass_cutoff_frequency>
       <muscle_analysis_coordinate_list>hip_flexion_r knee_angle_r</muscle_analysis_coordinate_list>
@@ -54,6 +58,10 @@ class AnalysisTrial:
                                     doc="Ground reactions (.mot/.sto) for inverse dynamics (optional)")
     external_loads_file: Path | None = setting("external_loads_file", kind="path", path_kind="file", default=None,
                                                doc="ExternalLoads XML applying the grf_file columns to bodies")
+    inverse_dynamics_file: Path | None = setting(
+        "inverse_dynamics_file", kind="path", path_kind="file", default=None,
+        doc="Joint moments measured otherwise (N m, columns <coordinate>_moment at the marker frames; e.g. a "
+            "dynamometer in passive trials): written to IDData in place of inverse dynamics")
     emg_file: Path | None = setting("emg_file", kind="path", path_kind="file", default=None,
                                     doc="Raw EMG (.mot/.sto), copied to EMGData for preprocessing (optional)")
     time_range: tuple[float, ...] | None = setting("time_range", kind="numbers", count=2, default=None,
@@ -64,6 +72,9 @@ class AnalysisTrial:
         if (values["grf_file"] is None) != (values["external_loads_file"] is None):
             raise ctx.error("grf_file", "grf_file and external_loads_file go together",
                             "both (inverse dynamics with ground reactions) or neither")
+        if values["inverse_dynamics_file"] is not None and values["grf_file"] is not None:
+            raise ctx.error("inverse_dynamics_file", "inverse_dynamics_file replaces inverse dynamics, so it "
+                            "cannot go with grf_file", "either measured moments or ground reactions, not both")
 
 
 @attrs.frozen(kw_only=True)

@@ -11,6 +11,7 @@ import pytest
 from nmsm.errors import InputError
 from nmsm.io.storage import Table
 from nmsm.tools.dispatch import tool_element_name
+from nmsm.tools.pipeline.analysis import measured_moments
 from nmsm.tools.pipeline.analysis import read_settings as read_analysis
 from nmsm.tools.pipeline.preprocess_stage import _linear_with_gaps, process_emg
 from nmsm.tools.pipeline.preprocess_stage import read_settings as read_preprocess
@@ -36,6 +37,31 @@ def test_analysis_settings_need_loads_with_ground_reactions(tmp_path: Path) -> N
     with pytest.raises(InputError, match="nope.trc"):
         read_analysis(missing)
     assert tool_element_name(missing) == "ModelAnalysisTool"
+
+
+def test_measured_moments_replace_inverse_dynamics(tmp_path: Path) -> None:
+    """A passive trial's measured moments: refused next to ground reactions; taken at the
+    marker frames; a file sampled elsewhere is named in the error."""
+    from nmsm.io.storage import write_storage
+
+    for name in ("model.osim", "trial.trc", "grf.mot", "loads.xml"):
+        (tmp_path / name).write_text("x")
+    moments_file = tmp_path / "moments.sto"
+    time = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 9)
+    write_storage(moments_file, Table(time=time, labels=("knee_angle_r_moment",), data=np.sin(time)))
+    both = _write(tmp_path / "a.xml", "<ModelAnalysisTool><input_model_file>model.osim</input_model_file>"
+                  "<TrialSet><Trial name='t'><marker_file>trial.trc</marker_file><grf_file>grf.mot</grf_file>"
+                  "<external_loads_file>loads.xml</external_loads_file>"
+                  "<inverse_dynamics_file>moments.sto</inverse_dynamics_file></Trial></TrialSet></ModelAnalysisTool>")
+    with pytest.raises(InputError, match="cannot go with grf_file"):
+        read_analysis(both)
+    frames = time[20:51]
+    taken = measured_moments(moments_file, frames)
+    np.testing.assert_allclose(taken.time, frames)
+    np.testing.assert_allclose(taken.column("knee_angle_r_moment"), np.sin(frames))
+    with pytest.raises(InputError, match="moments.sto") as error:
+        measured_moments(moments_file, np.linspace(0.2, 0.5, 7))
+    assert "markers give 7 frames" in str(error.value)
 
 
 def test_preprocess_settings_and_missing_trial(tmp_path: Path) -> None:
