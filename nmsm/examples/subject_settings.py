@@ -153,13 +153,7 @@ def ncp_xml(subject: Subject, folder: Path, n_synergies: int) -> str:
         <coordinate_list>{" ".join(sm.MUSCLE_COORDINATES)}</coordinate_list>
         <activation_muscle_groups/>
         <normalized_fiber_length_muscle_groups/>
-        <MuscleTendonLengthInitialization>
-          <is_enabled>true</is_enabled>
-          <passive_data_input_directory>results/passive</passive_data_input_directory>
-          <optimize_maximum_muscle_stress>false</optimize_maximum_muscle_stress>
-          <optimize_isometric_max_force>false</optimize_isometric_max_force>
-          <RCNLCostTermSet>{_term("passive_joint_moment", 1.0)}</RCNLCostTermSet>
-        </MuscleTendonLengthInitialization>
+        <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
         <mtp_results_directory>results/mtp</mtp_results_directory>
         <RCNLCostTermSet>{terms}</RCNLCostTermSet>
         <RCNLSynergySet>
