@@ -127,6 +127,8 @@ def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metric
         + ", ".join(f"{g.name}: {g.n_synergies} of {g.n_muscles} muscles" for g in inputs.layout.groups),
         f"bilateral symmetry (shared vectors): {'yes' if any(s is not None for s in inputs.layout.shared_from) else 'no'}",
         f"trials: {', '.join(t.name for t in inputs.trials)}; muscles with MTP activations: {len(inputs.mtp_muscles)}",
+        "muscles without MTP activations (driven by the moments only): "
+        + (", ".join(inputs.layout.muscles[i] for i in inputs.other_indices) or "none"),
         solved.summary(),
         "cost terms at the solution:",
         *[f"  {k:<40s} {v:.8g}" for k, v in costs.items()],

@@ -51,6 +51,21 @@ def test_mtp_activations_lacking_a_muscle_of_the_group(case) -> None:
     assert str(path) in message and "column 'vasti_l'" in message and "lack muscle(s) vasti_l" in message
 
 
+def test_muscle_without_mtp_activations_in_every_trial_is_named(case) -> None:
+    """A muscle missing from every trial's MTP activations is not an error (the moments drive
+    it, tools.md §5), but the run log names it."""
+    for path in (case.folder / "mtp" / "muscleActivations").glob("*.sto"):
+        table = read_storage(path)
+        write_storage(path, table_from_columns(table.time, {k: table.column(k) for k in table.labels
+                                                            if k != "vasti_l"}))
+    outcome = run_settings(case.settings_file, print_level=0)
+    log = (outcome.results_directory / "commandWindowOutput.txt").read_text()
+    prefix = "muscles without MTP activations (driven by the moments only): "
+    line = next(text for text in log.splitlines() if text.startswith(prefix))
+    named = line[len(prefix):].split(", ")
+    assert "vasti_l" in named and "vasti_r" not in named, line
+
+
 def test_mtp_activations_with_other_frame_count(case) -> None:
     path = case.folder / "mtp" / "muscleActivations" / "trial_1_muscleActivations.sto"
     table = read_storage(path)
