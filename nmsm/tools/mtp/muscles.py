@@ -80,21 +80,23 @@ def resolve_groups(
     *,
     setting: str,
     model_file: str | None = None,
+    settings_file: str | None = None,
     drop_empty: bool = True,
 ) -> tuple[MuscleGroup, ...]:
     """Groups named in a setting, as indices into ``muscle_names``.
 
-    Unknown group names are an :class:`InputError` naming the setting and listing the
-    model's groups. Members outside ``muscle_names`` are ignored (a warning says so);
+    Unknown group names are an :class:`InputError` naming the settings file (when given),
+    the setting, the model and the model's groups. Members outside ``muscle_names`` are ignored (a warning says so);
     a group left empty is dropped (with a warning) unless ``drop_empty`` is False.
     """
     out: list[MuscleGroup] = []
     position = {name: i for i, name in enumerate(muscle_names)}
     for group in group_names:
         if group not in model_groups:
+            model = f" {model_file}" if model_file else ""
             raise InputError(
-                f"muscle group '{group}' is not a ForceSet group of the model",
-                file=model_file,
+                f"muscle group '{group}' is not a ForceSet group of the model{model}",
+                file=settings_file or model_file,
                 element=f"<{setting}>",
                 expected="one of the model's groups: " + (", ".join(sorted(model_groups)) or "(none)"),
             )

@@ -140,13 +140,13 @@ def prepare(settings_file: str | os.PathLike[str], *, emg_spline_stride: int = 4
     coordinates = tuple(settings.coordinate_list)
     names = muscles_crossing(model, coordinates)
     muscles = muscle_parameters(model, names, osimx)
-    model_file = str(settings.input_model_file)
+    where = {"model_file": str(settings.input_model_file), "settings_file": str(settings.settings_file)}
     groups = model.groups
     collected = resolve_groups(settings.collected_emg_channel_muscle_groups, groups, names,
-                               setting="collected_emg_channel_muscle_groups", model_file=model_file, drop_empty=False)
+                               setting="collected_emg_channel_muscle_groups", **where, drop_empty=False)
     synx_settings = settings.synergy_extrapolation
     missing = resolve_groups(settings.missing_emg_channel_muscle_groups, groups, names,
-                             setting="missing_emg_channel_muscle_groups", model_file=model_file)
+                             setting="missing_emg_channel_muscle_groups", **where)
     channels = channel_map(names, collected, missing)
     if missing and not synx_settings.is_enabled:
         warnings.warn(
@@ -155,9 +155,9 @@ def prepare(settings_file: str | os.PathLike[str], *, emg_spline_stride: int = 4
             stacklevel=2,
         )
     activation_groups = resolve_groups(settings.activation_muscle_groups, groups, names,
-                                       setting="activation_muscle_groups", model_file=model_file)
+                                       setting="activation_muscle_groups", **where)
     fiber_groups = resolve_groups(settings.normalized_fiber_length_muscle_groups, groups, names,
-                                  setting="normalized_fiber_length_muscle_groups", model_file=model_file)
+                                  setting="normalized_fiber_length_muscle_groups", **where)
     prefixes = find_prefixes(settings.data_directory, settings.trial_prefixes)
     channel_names = [g.name for g in collected]
     trials = tuple(load_trial(settings.data_directory, p, coordinates, names, channel_names) for p in prefixes)

@@ -265,10 +265,12 @@ def load_ncp(
     activation_groups = resolve_groups(
         settings.activation_muscle_groups, model.groups, muscles, setting="activation_muscle_groups",
         model_file=str(settings.input_model_file),
+        settings_file=str(settings.settings_file),
     )
     fiber_groups = resolve_groups(
         settings.normalized_fiber_length_muscle_groups, model.groups, muscles,
         setting="normalized_fiber_length_muscle_groups", model_file=str(settings.input_model_file),
+        settings_file=str(settings.settings_file),
     )
     inputs = NcpInputs(
         layout=layout,

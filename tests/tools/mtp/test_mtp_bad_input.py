@@ -66,6 +66,8 @@ def test_emg_channel_not_a_model_group(case):
         prepare(settings)
     message = str(info.value)
     assert "Bogus" in message and "collected_emg_channel_muscle_groups" in message and "GlutMaxLat" in message
+    assert message.startswith(str(settings)), message  # the file holding the element, the model named too
+    assert ".osim" in message
 
 
 def test_emg_column_missing(case):
