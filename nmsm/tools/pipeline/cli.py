@@ -71,8 +71,8 @@ def register(subparsers: Any) -> None:
 
     p = subparsers.add_parser("example", help="the built-in synthetic subject: lab data to treatment, with the "
                                                "known answers")
-    p.add_argument("stage", nargs="?", help="run the example up to this stage (jmp, analysis, preprocess, mtp, "
-                                            "ncp, gcp, surrogate, to, vo, do); default all")
+    p.add_argument("stage", nargs="?", help="run the example up to this stage (jmp, passive, analysis, preprocess, "
+                                            "mtp, ncp, gcp, surrogate, to, vo, do); default all")
     p.add_argument("--folder", default="nmsm_example", help="where the subject and results go (default ./nmsm_example)")
     p.add_argument("--rebuild", action="store_true", help="regenerate the subject and redo every stage")
     p.add_argument("--strict", action="store_true", help="exit 1 when a recovered value is out of its tolerance")

@@ -111,6 +111,12 @@ def test_commands(early, capsys) -> None:
     assert (early.folder / "r.html").is_file()
     assert main(["example", "nonsense", "--folder", str(early.folder)]) == 1
     assert "no example stage 'nonsense'" in capsys.readouterr().err
+    from nmsm.examples.subject_settings import STAGES
+
+    with pytest.raises(SystemExit):
+        main(["example", "--help"])
+    listed = " ".join(capsys.readouterr().out.split())
+    assert "(" + ", ".join(STAGES) + ")" in listed, listed  # the help names every stage, in order
 
 
 @pytest.mark.slow
