@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -138,8 +139,9 @@ def effective_emg_scales(emg_time: np.ndarray, raw: np.ndarray, time: np.ndarray
     return out
 
 
-def _write_passive_trials(folder: Path, model, casadi_model, muscles) -> Path:
-    """Markers (100 Hz) and measured joint moments of each passive trial, on the true model."""
+def _write_passive_trials(folder: Path, model: Any, casadi_model: Any, muscles: Sequence[st.MuscleTruth]) -> Path:
+    """Markers (100 Hz, of ``casadi_model`` built on the true ``model``) and the measured joint
+    moments of each passive trial, written into ``folder``."""
     from nmsm.examples.subject_data import marker_table
     from nmsm.examples.subject_passive import PASSIVE_DURATION, PASSIVE_TRIALS, passive_moments, passive_poses
     from nmsm.io.storage import table_from_columns, write_storage
@@ -151,9 +153,9 @@ def _write_passive_trials(folder: Path, model, casadi_model, muscles) -> Path:
         q = passive_poses(model.coordinate_names, name, time, sm.STANDING_HEIGHT)
         write_trc(folder / f"{name}.trc", marker_table(casadi_model, model.marker_names, time, q), units="mm")
         moments = passive_moments(model, muscles, q)
+        columns = {f"{c}_moment": moments[:, k] for k, c in enumerate(sm.MUSCLE_COORDINATES)}
         write_storage(folder / f"{name}_moments.sto",
-                      table_from_columns(time, {f"{c}_moment": moments[:, k] for k, c in enumerate(sm.MUSCLE_COORDINATES)},
-                                         name="passive joint moments (N m)"))
+                      table_from_columns(time, columns, name="passive joint moments (N m)"))
     return folder
 
 

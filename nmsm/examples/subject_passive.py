@@ -19,6 +19,7 @@ Moment magnitudes stay below about 90 N m. Time on axis 0; SI units.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -59,9 +60,10 @@ def passive_poses(names: Sequence[str], trial: str, time: np.ndarray, standing_h
     return q
 
 
-def passive_moments(model, muscles: Sequence[MuscleTruth], q: np.ndarray) -> np.ndarray:
+def passive_moments(model: Any, muscles: Sequence[MuscleTruth], q: np.ndarray) -> np.ndarray:
     """Passive joint moments (T, C) N m on :data:`~nmsm.examples.subject_model.MUSCLE_COORDINATES`
-    of relaxed ``muscles`` (true lengths) at coordinates ``q`` (T, n_q, model order)."""
+    of relaxed ``muscles`` (true lengths) at coordinates ``q`` (T, n_q, model order) of the
+    parsed ``model`` (:func:`nmsm.model.osim.load_model`)."""
     from nmsm.model.muscle_geometry import MuscleGeometry
 
     names = [m.name for m in muscles]
