@@ -101,7 +101,7 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
     """MTLI fits the optimal fiber and tendon slack lengths to the passive trials; the MTP
     tasks then keep them and personalize delays, time constants, EMG scales and
     nonlinearities. (With the lengths free, one gait trial's moments trade them off against
-    the EMG scales: lengths 5-32 % off the truth and activations 0.039 RMS from it, against
+    the EMG scales: lengths 0.6-32 % off the truth and activations 0.039 RMS from it, against
     0.022 with MTLI's lengths; docs/pipeline.md.)"""
     channels = " ".join(spec.channel for spec in sm.MUSCLES.values())
     terms = _term("inverse_dynamics_joint_moment", 1.0)
