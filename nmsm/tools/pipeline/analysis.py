@@ -25,7 +25,7 @@ import os
 import shutil
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import attrs
 import numpy as np
@@ -33,6 +33,9 @@ import numpy as np
 from nmsm.core.results import ResultsDirectory
 from nmsm.tools.pipeline.analysis_settings import TOOL, AnalysisTrial, ModelAnalysisSettings
 from nmsm.tools.pipeline.native import read_native_settings
+
+if TYPE_CHECKING:
+    from nmsm.io.storage import Table
 
 REPORT_FILE = "analysis_report.txt"
 
@@ -59,7 +62,7 @@ def read_settings(path: str | os.PathLike[str]) -> ModelAnalysisSettings:
     return read_native_settings(path, ModelAnalysisSettings, TOOL)
 
 
-def measured_moments(path: Path, time: np.ndarray) -> Any:
+def measured_moments(path: Path, time: np.ndarray) -> Table:
     """The table of ``path`` (joint moments, N m) if it is sampled at the IK frames ``time``
     (s, within 1e-6 s), else an :class:`~nmsm.errors.InputError` naming the file."""
     from nmsm.errors import InputError
