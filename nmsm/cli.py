@@ -65,7 +65,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"nmsm: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("nmsm: stopped; finished tasks were kept in the results folder", file=sys.stderr)
+        print("nmsm: stopped; the interrupted task wrote nothing, finished tasks and stages are kept", file=sys.stderr)
         return 130
 
 

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.interrupts import interrupt_after_solve
 from nmsm.core.problem import Solution
 
 if TYPE_CHECKING:
@@ -83,7 +84,8 @@ def solve_ipopt(
     x0 = problem.initial_scaled() if initial_guess is None else np.asarray(initial_guess, dtype=float)
     x0 = np.clip(x0, lo, hi)
     start = time.perf_counter()
-    result = solver(x0=x0, p=problem.parameter_values(), lbx=lo, ubx=hi, lbg=lbg, ubg=ubg)
+    with interrupt_after_solve():  # Ctrl-C: KeyboardInterrupt, not an unconverged "result"
+        result = solver(x0=x0, p=problem.parameter_values(), lbx=lo, ubx=hi, lbg=lbg, ubg=ubg)
     wall = time.perf_counter() - start
     stats = solver.stats()
     x_opt = np.asarray(result["x"].full()).ravel()
