@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Sequence
 
 from nmsm import __version__
+from nmsm.core.progress import DEFAULT_INTERVAL, progress_every
 from nmsm.errors import NmsmError
 
 #: modules whose ``register(subparsers)`` adds sub-commands, in help order
@@ -37,6 +38,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"nmsm {__version__}")
     parser.add_argument("--traceback", action="store_true", help="show Python tracebacks on errors")
+    parser.add_argument(
+        "--progress", type=float, default=DEFAULT_INTERVAL, metavar="SECONDS",
+        help=f"print a solver progress line at most every SECONDS while a solve runs (default {DEFAULT_INTERVAL:g}; 0: off)",
+    )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:
@@ -58,7 +63,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     warnings.simplefilter("default")
     warnings.formatwarning = lambda msg, cat, *a, **k: f"warning: {msg}\n"
     try:
-        return int(args.func(args) or 0)
+        with progress_every(args.progress):
+            return int(args.func(args) or 0)
     except NmsmError as exc:
         if args.traceback:
             raise

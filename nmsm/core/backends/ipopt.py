@@ -16,6 +16,7 @@ import numpy as np
 
 from nmsm.core.interrupts import interrupt_after_solve
 from nmsm.core.problem import Solution
+from nmsm.core.progress import SolveProgress, solve_progress
 
 if TYPE_CHECKING:
     from nmsm.core.problem import OptimizationProblem
@@ -78,6 +79,9 @@ def solve_ipopt(
         opts["ipopt.acceptable_tol"] = float(acceptable_tol)
     for key, value in (ipopt_options or {}).items():
         opts[f"ipopt.{key}"] = value
+    progress = solve_progress(problem.name) if int(print_level) == 0 else None
+    if progress is not None:  # IPOPT silent: a progress line every few seconds instead
+        opts["iteration_callback"] = _ProgressCallback(progress, xs.numel(), g.numel(), ps.numel(), lbg, ubg)
     opts.update(casadi_options or {})
     solver = cs.nlpsol(problem.name.replace(" ", "_") or "nlp", "ipopt", nlp, opts)
     lo, hi = problem.bounds_scaled()
@@ -102,3 +106,38 @@ def solve_ipopt(
         x_scaled=x_opt,
         constraints=problem.constraint_report(x_opt),
     )
+
+
+class _ProgressCallback(cs.Callback):
+    """CasADi ``iteration_callback``: each IPOPT iterate's cost and largest constraint
+    violation go to a :class:`~nmsm.core.progress.SolveProgress`."""
+
+    def __init__(self, progress: SolveProgress, nx: int, ng: int, n_p: int, lbg: np.ndarray, ubg: np.ndarray) -> None:
+        cs.Callback.__init__(self)
+        self.progress = progress
+        self.sizes = {"x": nx, "f": 1, "g": ng, "lam_x": nx, "lam_g": ng, "lam_p": n_p}
+        self.lbg = np.asarray(lbg, dtype=float).ravel()
+        self.ubg = np.asarray(ubg, dtype=float).ravel()
+        self.construct("nmsm_progress", {})
+
+    def get_n_in(self) -> int:
+        return cs.nlpsol_n_out()
+
+    def get_n_out(self) -> int:
+        return 1
+
+    def get_name_in(self, i: int) -> str:
+        return cs.nlpsol_out(i)
+
+    def get_name_out(self, i: int) -> str:
+        return "ret"
+
+    def get_sparsity_in(self, i: int) -> cs.Sparsity:
+        return cs.Sparsity.dense(self.sizes[cs.nlpsol_out(i)], 1)
+
+    def eval(self, arg: list[cs.DM]) -> list[int]:
+        f = float(arg[cs.nlpsol_out().index("f")])
+        g = np.asarray(arg[cs.nlpsol_out().index("g")]).ravel()
+        violation = float(np.max(np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0))) if g.size else None
+        self.progress.step(f, violation)
+        return [0]

@@ -16,6 +16,7 @@ import scipy.optimize
 import scipy.sparse
 
 from nmsm.core.problem import Solution
+from nmsm.core.progress import with_least_squares_progress
 
 if TYPE_CHECKING:
     from nmsm.core.problem import OptimizationProblem
@@ -91,6 +92,8 @@ def solve_least_squares(
     if free_idx.size == 0 or n_res == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
+        if not verbose:
+            fun, jac = with_least_squares_progress(problem.name, fun, jac)
         res = scipy.optimize.least_squares(
             fun, x0[free_idx], jac=jac, bounds=(lo[free_idx], hi[free_idx]), method=method,
             ftol=ftol, xtol=xtol, gtol=gtol, max_nfev=max_nfev, verbose=verbose,

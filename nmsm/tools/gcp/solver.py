@@ -27,6 +27,7 @@ import scipy.optimize
 import scipy.sparse
 
 from nmsm.core.problem import OptimizationProblem, Solution
+from nmsm.core.progress import with_least_squares_progress
 from nmsm.tools.gcp.blas_threads import single_threaded_blas
 from nmsm.tools.gcp.problem import TaskProblem
 
@@ -113,9 +114,12 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
     if free.size == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
+        fun, jac = lambda xf: lifted.residuals(full(xf)), lambda xf: lifted.jacobian(full(xf))[:, free]
+        if not verbose:
+            fun, jac = with_least_squares_progress(problem.name, fun, jac)
         with single_threaded_blas():  # LSMR's many small BLAS calls (nmsm.tools.gcp.blas_threads)
             result = scipy.optimize.least_squares(
-                lambda xf: lifted.residuals(full(xf)), x0[free], jac=lambda xf: lifted.jacobian(full(xf))[:, free],
+                fun, x0[free], jac=jac,
                 bounds=(lo[free], hi[free]), method="trf", tr_solver="lsmr", ftol=ftol, xtol=xtol, gtol=gtol,
                 max_nfev=max_nfev, verbose=verbose)
         x_opt, status, nfev, success = full(result.x), str(result.message), int(result.nfev), bool(result.status > 0)
