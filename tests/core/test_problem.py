@@ -9,17 +9,9 @@ import pytest
 from nmsm.core.problem import OptimizationProblem
 
 
-def _rosenbrock_like() -> OptimizationProblem:
-    prob = OptimizationProblem("rosen")
-    x = prob.variable("x", [-1.2, 1.0], lower=-5, upper=5)
-    prob.add_cost("a", 1 - x[0])
-    prob.add_cost("b", 10 * (x[1] - x[0] ** 2))
-    return prob
-
-
 @pytest.mark.parametrize("backend", ["least_squares", "ipopt"])
-def test_rosenbrock_minimum(backend: str) -> None:
-    sol = _rosenbrock_like().solve(backend, **({"print_level": 0} if backend == "ipopt" else {}))
+def test_rosenbrock_minimum(rosenbrock, backend: str) -> None:
+    sol = rosenbrock().solve(backend, **({"print_level": 0} if backend == "ipopt" else {}))
     assert sol.success
     np.testing.assert_allclose(sol["x"].ravel(), [1.0, 1.0], atol=1e-6)
     assert sol.cost < 1e-12
@@ -75,6 +67,6 @@ def test_matrix_variable_column_major_roundtrip() -> None:
     np.testing.assert_allclose(sol["w"], init * 2, atol=1e-8)
 
 
-def test_unknown_backend() -> None:
+def test_unknown_backend(rosenbrock) -> None:
     with pytest.raises(ValueError, match="unknown back end"):
-        _rosenbrock_like().solve("simplex")
+        rosenbrock().solve("simplex")

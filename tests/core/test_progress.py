@@ -23,14 +23,6 @@ def _constrained() -> OptimizationProblem:
     return problem
 
 
-def _rosenbrock() -> OptimizationProblem:
-    problem = OptimizationProblem("rosenbrock_demo")
-    x = problem.variable("x", [-1.2, 1.0], lower=-5.0, upper=5.0)
-    problem.add_cost("a", 1 - x[0])
-    problem.add_cost("b", 10 * (x[1] - x[0] ** 2))
-    return problem
-
-
 def _lines(text: str) -> list[re.Match[str]]:
     matches = [LINE.match(line) for line in text.splitlines() if line.startswith("[progress]")]
     assert all(matches), text
@@ -49,9 +41,9 @@ def test_ipopt_reports_each_iteration_when_the_interval_is_tiny(capsys):
     assert float(lines[-1][5]) <= 1e-8  # the equality holds at the end
 
 
-def test_least_squares_reports_its_iterations(capsys):
+def test_least_squares_reports_its_iterations(capsys, rosenbrock):
     with progress_every(1e-9):
-        solution = _rosenbrock().solve("least_squares")
+        solution = rosenbrock().solve("least_squares")
     lines = _lines(capsys.readouterr().err)
     assert solution.success and lines
     assert all(m[4] is None for m in lines)  # no constraints: no violation column
@@ -60,11 +52,11 @@ def test_least_squares_reports_its_iterations(capsys):
 
 
 @pytest.mark.parametrize("backend", ["ipopt", "least_squares"])
-def test_silent_without_progress_or_with_zero_interval(capsys, backend):
+def test_silent_without_progress_or_with_zero_interval(capsys, rosenbrock, backend):
     options = {"print_level": 0} if backend == "ipopt" else {}
-    _rosenbrock().solve(backend, **options)
+    rosenbrock().solve(backend, **options)
     with progress_every(0):
-        _rosenbrock().solve(backend, **options)
+        rosenbrock().solve(backend, **options)
     assert "[progress]" not in capsys.readouterr().err
 
 
