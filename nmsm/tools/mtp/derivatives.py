@@ -21,8 +21,12 @@ import casadi as cs
 from nmsm.core.problem import OptimizationProblem
 
 
-def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequence[str] = ()) -> dict[str, Any]:
+def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequence[str] = (),
+                          threads: int = 1) -> dict[str, Any]:
     """``{"jac_g": Function(x, p) -> (g, J), "hess_lag": Function(x, p, lam_f, lam_g) -> H}``.
+
+    With ``threads`` > 1 the blocks of ``J`` and ``H`` are dealt round-robin into that many
+    groups, evaluated on parallel threads and summed (:func:`parallel_sum`).
 
     ``H`` is the upper triangle (``triu``) of the symmetric Hessian, as CasADi's own
     ``nlp_hess_l`` returns it. Cost terms named in ``gauss_newton`` contribute their
@@ -37,21 +41,69 @@ def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequenc
     p = problem.parameter_vector()
     g, _, _ = problem.constraint_vector()
     blocks = [c.expression for c in problem.constraints]
-    jac = cs.vertcat(*[cs.jacobian(b, x) for b in blocks]) if blocks else cs.MX(0, x.numel())
+    n_g, n_x = g.numel(), x.numel()
+    jacobians = [cs.jacobian(b, x) for b in blocks]
+    jac = parallel_vertcat(jacobians, [x, p], threads) if blocks else cs.MX(0, n_x)
     jac_g = cs.Function("nlp_jac_g", [x, p], [g, jac], ["x", "p"], ["g", "jac_g_x"])
     lam_f = cs.MX.sym("lam_f")
-    lam_g = cs.MX.sym("lam_g", g.numel())
-    hess = lam_f * _objective_hessian(problem, x, set(gauss_newton))
+    lam_g = cs.MX.sym("lam_g", n_g)
+    parts = [cs.triu(lam_f * _objective_hessian(problem, x, set(gauss_newton)))]
     start = 0
     for b in blocks:
         n = b.numel()
         if n:
-            hess = hess + _hessian(cs.dot(lam_g[start : start + n], b), x)
+            parts.append(cs.triu(_hessian(cs.dot(lam_g[start : start + n], b), x)))
         start += n
+    hess = parallel_sum(parts, [x, p, lam_f, lam_g], threads)
     hess_lag = cs.Function(
-        "nlp_hess_l", [x, p, lam_f, lam_g], [cs.triu(hess)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+        "nlp_hess_l", [x, p, lam_f, lam_g], [hess], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
     )
     return {"jac_g": jac_g, "hess_lag": hess_lag}
+
+
+def parallel_sum(parts: Sequence[cs.MX], inputs: Sequence[cs.MX], threads: int) -> cs.MX:
+    """``sum(parts)`` (MX of one shape, functions of ``inputs``), the parts dealt round-robin
+    into ``threads`` groups evaluated in parallel (:func:`_in_parallel`); ``threads`` <= 1:
+    the plain sum."""
+    groups = [parts[k::threads] for k in range(max(1, min(threads, len(parts))))]
+    sums = [_sum(group, parts[0].shape) for group in groups]
+    return sums[0] if len(sums) == 1 else _in_parallel(sums, inputs)
+
+
+def parallel_vertcat(blocks: Sequence[cs.MX], inputs: Sequence[cs.MX], threads: int) -> cs.MX:
+    """``vertcat(blocks)`` (MX with one column count), the blocks dealt round-robin into
+    ``threads`` groups evaluated in parallel: each group fills its blocks' rows of the
+    whole matrix (zeros elsewhere) and the groups are summed; ``threads`` <= 1: the plain
+    ``vertcat``."""
+    n_groups = max(1, min(threads, len(blocks)))
+    if n_groups == 1:
+        return cs.vertcat(*blocks)
+    groups = [
+        cs.vertcat(*[b if i % n_groups == k else cs.MX(*b.shape) for i, b in enumerate(blocks)])
+        for k in range(n_groups)
+    ]
+    return _in_parallel(groups, inputs)
+
+
+def _sum(parts: Sequence[cs.MX], shape: tuple[int, int]) -> cs.MX:
+    total = cs.MX(*shape)
+    for part in parts:
+        total = total + part
+    return total
+
+
+def _in_parallel(groups: Sequence[cs.MX], inputs: Sequence[cs.MX]) -> cs.MX:
+    """``sum(groups)``, each group on its own thread: every group (on the union sparsity of
+    all) is one case of a switch function, mapped over the groups with CasADi's ``thread``
+    parallelization and summed by the map's output reduction. Groups are dealt
+    deterministically, so a run's floating-point sums do not depend on timing."""
+    union = groups[0].sparsity()
+    for group in groups[1:]:
+        union = union + group.sparsity()
+    cases = [cs.Function(f"group_{k}", list(inputs), [cs.project(g, union)]) for k, g in enumerate(groups)]
+    switch = cs.Function.conditional("groups", cases, cases[-1])
+    mapped = switch.map("parallel_groups", "thread", len(cases), list(range(1, len(inputs) + 1)), [0])
+    return mapped(cs.DM(range(len(cases))).T, *inputs)
 
 
 def _objective_hessian(problem: OptimizationProblem, x: cs.MX, gauss_newton: set[str]) -> cs.MX:

@@ -25,6 +25,8 @@ excitations are bounded to [0, 1] (linear).
 
 from __future__ import annotations
 
+import os
+
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -75,6 +77,9 @@ TASK_MU_INIT = 1e-3
 #: iterations in 134.6 s of IPOPT time instead of 144.5 s (2026-11-26, docs/mtp.md); the
 #: tutorial V1 unchanged (2.1 s).
 TASK_MUMPS_ORDERING = 2
+#: threads of the block-wise Jacobian and Hessian evaluations of :func:`solve_task_problem`
+#: (:func:`nmsm.tools.mtp.derivatives.parallel_sum`): two where the machine has two cores.
+DERIVATIVE_THREADS = min(2, os.cpu_count() or 1)
 
 
 @attrs.frozen(eq=False)
@@ -311,14 +316,15 @@ def solve_task_problem(problem: OptimizationProblem, *, max_iterations: int, tol
                        print_level: int = 0) -> Solution:
     """Solve an MTP task problem as ``nmsm run`` does: IPOPT with block-wise exact
     derivatives (:func:`nmsm.tools.mtp.derivatives.blockwise_derivatives`) and
-    ``mu_init`` = :data:`TASK_MU_INIT` and MUMPS ordering :data:`TASK_MUMPS_ORDERING`."""
+    ``mu_init`` = :data:`TASK_MU_INIT` and MUMPS ordering :data:`TASK_MUMPS_ORDERING`;
+    the derivative blocks on :data:`DERIVATIVE_THREADS` threads."""
     return problem.solve(
         "ipopt",
         max_iter=int(max_iterations),
         tol=float(tolerance),
         print_level=print_level,
         ipopt_options={"mu_init": TASK_MU_INIT, "mumps_pivot_order": TASK_MUMPS_ORDERING},
-        casadi_options=blockwise_derivatives(problem),
+        casadi_options=blockwise_derivatives(problem, threads=DERIVATIVE_THREADS),
     )
 
 
