@@ -4,8 +4,8 @@ CasADi's default Jacobian of the constraints and Hessian of the Lagrangian colou
 *whole* sparsity pattern at once, so one block that needs many colours (MTP's moment
 rows, which touch every muscle of a frame) makes every block pay for them. Here each
 constraint block and the objective get their own derivative (their own colouring, forward
-or reverse), and the results are stacked / summed. Values are identical to the
-default; only the cost changes.
+or reverse), and the results are stacked / summed, optionally by groups of blocks on
+parallel threads. Values are identical to the default (to rounding); only the cost changes.
 
 Use: ``problem.solve("ipopt", casadi_options=blockwise_derivatives(problem))`` (MTP tasks:
 :func:`nmsm.tools.mtp.problem.solve_task_problem`).
@@ -25,9 +25,6 @@ def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequenc
                           threads: int = 1) -> dict[str, Any]:
     """``{"jac_g": Function(x, p) -> (g, J), "hess_lag": Function(x, p, lam_f, lam_g) -> H}``.
 
-    With ``threads`` > 1 the blocks of ``J`` and ``H`` are dealt round-robin into that many
-    groups, evaluated on parallel threads and summed (:func:`parallel_sum`).
-
     ``H`` is the upper triangle (``triu``) of the symmetric Hessian, as CasADi's own
     ``nlp_hess_l`` returns it. Cost terms named in ``gauss_newton`` contribute their
     Gauss-Newton matrix ``2 w J^T J`` (``J`` their exact residual Jacobian) instead of their
@@ -35,7 +32,9 @@ def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequenc
     Synergy Extrapolation activation terms: their exact second derivatives dominate the
     Hessian time on Patient 3 and Gauss-Newton is ~10 times cheaper per evaluation, but on
     tutorial V1 IPOPT then stopped unconverged at 150 iterations instead of converging in
-    50, so ``nmsm run`` keeps the exact Hessian.)
+    50, so ``nmsm run`` keeps the exact Hessian.) With ``threads`` > 1 the blocks of ``J``
+    and ``H`` are dealt round-robin into that many groups evaluated on parallel threads
+    (:func:`parallel_vertcat`, :func:`parallel_sum`).
     """
     x = problem.scaled_vector()
     p = problem.parameter_vector()
@@ -65,8 +64,8 @@ def parallel_sum(parts: Sequence[cs.MX], inputs: Sequence[cs.MX], threads: int) 
     """``sum(parts)`` (MX of one shape, functions of ``inputs``), the parts dealt round-robin
     into ``threads`` groups evaluated in parallel (:func:`_in_parallel`); ``threads`` <= 1:
     the plain sum."""
-    groups = [parts[k::threads] for k in range(max(1, min(threads, len(parts))))]
-    sums = [_sum(group, parts[0].shape) for group in groups]
+    n_groups = max(1, min(threads, len(parts)))
+    sums = [_sum(parts[k::n_groups], parts[0].shape) for k in range(n_groups)]
     return sums[0] if len(sums) == 1 else _in_parallel(sums, inputs)
 
 

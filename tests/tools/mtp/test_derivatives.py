@@ -73,7 +73,7 @@ def test_parallel_groups_give_the_sequential_derivatives():
     x = p.scaled_vector()
     jac_ref = np.array(cs.Function("j", [x], [cs.jacobian(p.constraint_vector()[0], x)])([0.4, -0.2, 0.9, 0.7]).full())
     assert np.allclose(jac1, jac_ref, atol=1e-14)
-    for threads in (2, 3, 8):  # 8 > 5 parts: one group per part
+    for threads in (0, 2, 3, 8):  # 0: the plain sum; 8 > 5 parts: one group per part
         g, jac, hess = _evaluate(p, threads)
         assert np.array_equal(g, g1)
         assert np.allclose(jac, jac1, atol=1e-14) and np.allclose(hess, hess1, atol=1e-13), threads
