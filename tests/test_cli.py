@@ -1,0 +1,22 @@
+"""The ``nmsm`` command line as a whole: ``python -m nmsm`` and the global options."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from nmsm import __version__
+from nmsm.cli import build_parser
+
+
+def test_python_dash_m_runs_the_command_line():
+    done = subprocess.run([sys.executable, "-m", "nmsm", "--version"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == f"nmsm {__version__}"
+
+
+def test_progress_interval_option():
+    parser = build_parser()
+    assert parser.parse_args(["plugins"]).progress == 10.0
+    assert parser.parse_args(["--progress", "0", "plugins"]).progress == 0.0
+    assert parser.parse_args(["--progress", "2.5", "plugins"]).progress == 2.5
