@@ -38,6 +38,32 @@ def _sparse(value: cs.DM) -> scipy.sparse.csc_matrix:
                                     np.asarray(sp.colind())), shape=(sp.size1(), sp.size2()))
 
 
+class _SparseOutput:
+    """A CasADi Function of ``(x, p)`` whose one output is a sparse matrix, evaluated
+    through CasADi's buffer interface straight into a scipy CSC matrix: the pattern is read
+    once, and no DM is made per call (converting a GCP Jacobian's DM took about as long as
+    computing it)."""
+
+    def __init__(self, function: cs.Function) -> None:
+        sp = function.sparsity_out(0)
+        self.shape = (sp.size1(), sp.size2())
+        self.indices = np.asarray(sp.row(), dtype=np.int64)
+        self.indptr = np.asarray(sp.colind(), dtype=np.int64)
+        self._x = np.zeros(function.nnz_in(0))
+        self._p = np.zeros(function.nnz_in(1))
+        self._out = np.zeros(sp.nnz())
+        self._buffer, self._evaluate = function.buffer()
+        self._buffer.set_arg(0, memoryview(self._x))
+        self._buffer.set_arg(1, memoryview(self._p))
+        self._buffer.set_res(0, memoryview(self._out))
+
+    def __call__(self, x: np.ndarray, p: np.ndarray) -> scipy.sparse.csc_matrix:
+        self._x[:] = x
+        self._p[:] = p
+        self._evaluate()
+        return scipy.sparse.csc_matrix((self._out.copy(), self.indices, self.indptr), shape=self.shape)
+
+
 class LiftedResiduals:
     """``r(x)`` and ``dr/dx`` of a task problem with lifted foot coordinates (module docstring)."""
 
@@ -54,6 +80,7 @@ class LiftedResiduals:
         self.f_residuals = cs.Function("residuals", [xs, ps], [r])
         self.f_jac_x = cs.Function("jac_x", [xs, ps], [cs.jacobian(r, xs)])
         self.f_jac_z = cs.Function("jac_z", [xs, ps], [cs.jacobian(r, z)])
+        self._jac_x, self._jac_z = _SparseOutput(self.f_jac_x), _SparseOutput(self.f_jac_z)
         self.f_z = cs.Function("z", [xs], [z_of_x])
         self.lift_matrix = _sparse(cs.Function("dz_dx", [xs], [cs.jacobian(z_of_x, xs)])(np.zeros(xs.numel())))
         index, start = {}, 0
@@ -78,9 +105,9 @@ class LiftedResiduals:
 
     def jacobian(self, x: np.ndarray) -> scipy.sparse.csc_matrix:
         p = self.parameters(x)
-        jac = _sparse(self.f_jac_x(x, p))
+        jac = self._jac_x(x, p)
         if self.names:
-            jac = jac + _sparse(self.f_jac_z(x, p)) @ self.lift_matrix
+            jac = jac + self._jac_z(x, p) @ self.lift_matrix
         return jac.tocsc()
 
     def store(self, x: np.ndarray) -> None:
