@@ -15,19 +15,12 @@ import numpy as np
 import scipy.optimize
 import scipy.sparse
 
+from nmsm.core.backends.sparse import SparseOutput
 from nmsm.core.problem import Solution
 from nmsm.core.progress import with_least_squares_progress
 
 if TYPE_CHECKING:
     from nmsm.core.problem import OptimizationProblem
-
-
-def _casadi_sparse(fun: cs.Function, x: np.ndarray, p: np.ndarray) -> scipy.sparse.csc_matrix:
-    out = fun(x, p)
-    sp = out.sparsity()
-    rows, cols = sp.size1(), sp.size2()
-    data = np.asarray(out.nonzeros(), dtype=float)
-    return scipy.sparse.csc_matrix((data, np.asarray(sp.row()), np.asarray(sp.colind())), shape=(rows, cols))
 
 
 def solve_least_squares(
@@ -59,7 +52,7 @@ def solve_least_squares(
     ps = problem.parameter_vector()
     r = problem.residual_vector()
     f_res = cs.Function("residuals", [xs, ps], [r])
-    f_jac = cs.Function("jacobian", [xs, ps], [cs.jacobian(r, xs)])
+    jacobian = SparseOutput(cs.Function("jacobian", [xs, ps], [cs.jacobian(r, xs)]))
     p = problem.parameter_values()
     x0 = problem.initial_scaled()
     lo, hi = problem.bounds_scaled()
@@ -85,7 +78,7 @@ def solve_least_squares(
     solver = tr_solver or ("lsmr" if large else "exact")
 
     def jac(xf: np.ndarray) -> Any:
-        J = _casadi_sparse(f_jac, full(xf), p)[:, free_idx]
+        J = jacobian(full(xf), p)[:, free_idx]
         return J if solver == "lsmr" else J.toarray()
 
     start = time.perf_counter()

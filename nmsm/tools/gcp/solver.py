@@ -26,42 +26,11 @@ import numpy as np
 import scipy.optimize
 import scipy.sparse
 
+from nmsm.core.backends.sparse import SparseOutput, dm_to_csc
 from nmsm.core.problem import OptimizationProblem, Solution
 from nmsm.core.progress import with_least_squares_progress
 from nmsm.tools.gcp.blas_threads import single_threaded_blas
 from nmsm.tools.gcp.problem import TaskProblem
-
-
-def _sparse(value: cs.DM) -> scipy.sparse.csc_matrix:
-    sp = value.sparsity()
-    return scipy.sparse.csc_matrix((np.asarray(value.nonzeros(), dtype=float), np.asarray(sp.row()),
-                                    np.asarray(sp.colind())), shape=(sp.size1(), sp.size2()))
-
-
-class _SparseOutput:
-    """A CasADi Function of ``(x, p)`` whose one output is a sparse matrix, evaluated
-    through CasADi's buffer interface straight into a scipy CSC matrix: the pattern is read
-    once, and no DM is made per call (converting a GCP Jacobian's DM took about as long as
-    computing it)."""
-
-    def __init__(self, function: cs.Function) -> None:
-        sp = function.sparsity_out(0)
-        self.shape = (sp.size1(), sp.size2())
-        self.indices = np.asarray(sp.row(), dtype=np.int64)
-        self.indptr = np.asarray(sp.colind(), dtype=np.int64)
-        self._x = np.zeros(function.nnz_in(0))
-        self._p = np.zeros(function.nnz_in(1))
-        self._out = np.zeros(sp.nnz())
-        self._buffer, self._evaluate = function.buffer()
-        self._buffer.set_arg(0, memoryview(self._x))
-        self._buffer.set_arg(1, memoryview(self._p))
-        self._buffer.set_res(0, memoryview(self._out))
-
-    def __call__(self, x: np.ndarray, p: np.ndarray) -> scipy.sparse.csc_matrix:
-        self._x[:] = x
-        self._p[:] = p
-        self._evaluate()
-        return scipy.sparse.csc_matrix((self._out.copy(), self.indices, self.indptr), shape=self.shape)
 
 
 class LiftedResiduals:
@@ -80,9 +49,9 @@ class LiftedResiduals:
         self.f_residuals = cs.Function("residuals", [xs, ps], [r])
         self.f_jac_x = cs.Function("jac_x", [xs, ps], [cs.jacobian(r, xs)])
         self.f_jac_z = cs.Function("jac_z", [xs, ps], [cs.jacobian(r, z)])
-        self._jac_x, self._jac_z = _SparseOutput(self.f_jac_x), _SparseOutput(self.f_jac_z)
+        self._jac_x, self._jac_z = SparseOutput(self.f_jac_x), SparseOutput(self.f_jac_z)
         self.f_z = cs.Function("z", [xs], [z_of_x])
-        self.lift_matrix = _sparse(cs.Function("dz_dx", [xs], [cs.jacobian(z_of_x, xs)])(np.zeros(xs.numel())))
+        self.lift_matrix = dm_to_csc(cs.Function("dz_dx", [xs], [cs.jacobian(z_of_x, xs)])(np.zeros(xs.numel())))
         index, start = {}, 0
         for p in problem.parameters.values():
             index[p.name] = (start, p.shape)

@@ -11,7 +11,8 @@ from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.tools.gcp.problem import build_task_problem
 from nmsm.tools.gcp.run import load_feet
-from nmsm.tools.gcp.solver import LiftedResiduals, _sparse
+from nmsm.core.backends.sparse import dm_to_csc
+from nmsm.tools.gcp.solver import LiftedResiduals
 from nmsm.tools.gcp.state import GcpState
 
 
@@ -36,8 +37,8 @@ def test_lifted_jacobian_is_exact(synthetic_case):
         x = direct.initial_scaled() + 0.01 * rng.standard_normal(direct.n_variables)
         r_direct, j_direct = f(x, direct.parameter_values())
         np.testing.assert_allclose(lifted.residuals(x), np.array(r_direct).ravel(), rtol=1e-12, atol=1e-10)
-        difference = lifted.jacobian(x) - _sparse(j_direct)
-        assert abs(difference).max() <= 1e-9 * max(1.0, abs(_sparse(j_direct)).max())
+        difference = lifted.jacobian(x) - dm_to_csc(j_direct)
+        assert abs(difference).max() <= 1e-9 * max(1.0, abs(dm_to_csc(j_direct)).max())
 
 
 def test_single_threaded_blas_sets_and_restores_thread_counts():
