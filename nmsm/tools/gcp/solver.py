@@ -106,11 +106,16 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
         x[free] = xf
         return x
 
+    def fun(xf: np.ndarray) -> np.ndarray:
+        return lifted.residuals(full(xf))
+
+    def jac(xf: np.ndarray) -> scipy.sparse.csc_matrix:
+        return lifted.jacobian(full(xf))[:, free]
+
     start = time.perf_counter()
     if free.size == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
-        fun, jac = lambda xf: lifted.residuals(full(xf)), lambda xf: lifted.jacobian(full(xf))[:, free]
         if not verbose:
             fun, jac = with_least_squares_progress(problem.name, fun, jac)
         with single_threaded_blas():  # LSMR's many small BLAS calls (nmsm.tools.gcp.blas_threads)
