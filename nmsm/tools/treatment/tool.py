@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import os
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -33,6 +34,12 @@ CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMu
                        ("RCNLTorqueController", "torque_controller"))
 
 
+#: threads of the per-point model functions (CasADi ``map`` with ``thread``
+#: parallelization): two where the machine has two cores. Same iterates as one thread;
+#: measured 2026-11-26: synergy TO V4 29.2 -> 20.4 s, torque TO V2 9.5 -> 7.0 s (docs/treatment.md).
+DEFAULT_PARALLEL = min(2, os.cpu_count() or 1)
+
+
 @attrs.define
 class TreatmentOptions:
     """Run-time options of :func:`nmsm.tools.treatment.run.run_settings` (all optional).
@@ -45,7 +52,7 @@ class TreatmentOptions:
     ('initial': IPOPT minimizes the objective divided by its value at the initial guess,
     clipped to [1e-6, 1e6], so ``setup_nlp_tolerance`` acts on a relative scale; 'none';
     or a number: IPOPT's ``obj_scaling_factor``). ``parallel``: threads for
-    the per-point model functions. ``rescale_prescribed_derivatives``: with a free final time,
+    the per-point model functions (default :data:`DEFAULT_PARALLEL`). ``rescale_prescribed_derivatives``: with a free final time,
     scale the prescribed coordinates' speeds and accelerations to the new duration (default;
     False reproduces the original, which keeps the data's speeds). ``warm_start``: start IPOPT
     with a small barrier parameter and bound push (mu_init 1e-6, bound_push/frac 1e-9) so it
@@ -69,7 +76,7 @@ class TreatmentOptions:
     objective_scaling: str | float = "initial"
     rescale_prescribed_derivatives: bool = True
     warm_start: bool | None = None
-    parallel: int = 1
+    parallel: int = DEFAULT_PARALLEL
     evaluate_only: bool = False
     write_results: bool = True
 
