@@ -2,9 +2,9 @@
 
 The command line switches them on (:func:`progress_every`, every 10 s by default; ``nmsm
 --no-progress`` turns them off); library calls stay silent unless they do the same. A back end
-asks :func:`solve_progress` for a reporter and calls :meth:`SolveProgress.step` once per
-iteration; a line is printed only when ``interval`` seconds have passed since the last one
-(or since the solve started), so short solves print nothing::
+asks :func:`solve_progress` for a reporter and calls :meth:`SolveProgress.tick` once per
+iteration; a line is due only when ``interval`` seconds have passed since the last one (or
+since the solve started), so short solves print nothing::
 
     [progress] mtp_task_1: iteration 40, cost 74.448, constraint violation 7.3e-03, 48 s
 """
@@ -51,13 +51,16 @@ class SolveProgress:
     def __attrs_post_init__(self) -> None:
         self._last = self._start
 
-    def step(self, cost: float, violation: float | None = None) -> None:
-        """One iteration done; ``cost`` the objective, ``violation`` the largest constraint
-        violation (None: the problem has no constraints)."""
+    def tick(self) -> bool:
+        """Count one finished iteration; True when a line is due (then call :meth:`report`).
+        Callers compute what the line shows only when it is due."""
         self.iteration += 1
+        return time.perf_counter() - self._last >= self.interval
+
+    def report(self, cost: float, violation: float | None = None) -> None:
+        """Print the line of the current iteration: ``cost`` the objective, ``violation`` the
+        largest constraint violation (None: the problem has no constraints)."""
         now = time.perf_counter()
-        if now - self._last < self.interval:
-            return
         self._last = now
         parts = [f"iteration {self.iteration}", f"cost {cost:.6g}"]
         if violation is not None:
@@ -78,20 +81,22 @@ def with_least_squares_progress(
     """``fun`` and ``jac`` for scipy's ``least_squares``, reporting progress when it is on.
 
     scipy evaluates the Jacobian once per accepted step, at the point of the last residual
-    evaluation: each Jacobian call reports one iteration with that point's ``sum(r**2)``.
+    evaluation: each Jacobian call counts one iteration, reported with that point's
+    ``sum(r**2)``.
     """
     progress = solve_progress(name)
     if progress is None:
         return fun, jac
-    last_cost = [float("nan")]
+    last_residuals = [np.full(1, np.nan)]
 
     def reporting_fun(x: np.ndarray) -> np.ndarray:
-        r = fun(x)
-        last_cost[0] = float(np.dot(r, r))
+        last_residuals[0] = r = fun(x)
         return r
 
     def reporting_jac(x: np.ndarray) -> Any:
-        progress.step(last_cost[0])
+        if progress.tick():
+            r = last_residuals[0]
+            progress.report(float(np.dot(r, r)))
         return jac(x)
 
     return reporting_fun, reporting_jac

@@ -136,8 +136,9 @@ class _ProgressCallback(cs.Callback):
         return cs.Sparsity.dense(self.sizes[cs.nlpsol_out(i)], 1)
 
     def eval(self, arg: list[cs.DM]) -> list[int]:
-        f = float(arg[cs.nlpsol_out().index("f")])
-        g = np.asarray(arg[cs.nlpsol_out().index("g")]).ravel()
-        violation = float(np.max(np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0))) if g.size else None
-        self.progress.step(f, violation)
+        if self.progress.tick():
+            f = float(arg[cs.nlpsol_out().index("f")])
+            g = np.asarray(arg[cs.nlpsol_out().index("g")]).ravel()
+            violation = float(np.max(np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0))) if g.size else None
+            self.progress.report(f, violation)
         return [0]

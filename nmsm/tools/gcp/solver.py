@@ -47,9 +47,8 @@ class LiftedResiduals:
         z_of_x = cs.vertcat(*[cs.vec(task.lifted[n]) for n in names]) if names else cs.MX(0, 1)
         self.names = names
         self.f_residuals = cs.Function("residuals", [xs, ps], [r])
-        self.f_jac_x = cs.Function("jac_x", [xs, ps], [cs.jacobian(r, xs)])
-        self.f_jac_z = cs.Function("jac_z", [xs, ps], [cs.jacobian(r, z)])
-        self._jac_x, self._jac_z = SparseOutput(self.f_jac_x), SparseOutput(self.f_jac_z)
+        self._jac_x = SparseOutput(cs.Function("jac_x", [xs, ps], [cs.jacobian(r, xs)]))
+        self._jac_z = SparseOutput(cs.Function("jac_z", [xs, ps], [cs.jacobian(r, z)]))
         self.f_z = cs.Function("z", [xs], [z_of_x])
         self.lift_matrix = dm_to_csc(cs.Function("dz_dx", [xs], [cs.jacobian(z_of_x, xs)])(np.zeros(xs.numel())))
         index, start = {}, 0

@@ -25,8 +25,6 @@ excitations are bounded to [0, 1] (linear).
 
 from __future__ import annotations
 
-import os
-
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -37,6 +35,7 @@ import numpy as np
 
 from nmsm.core.problem import OptimizationProblem, Solution
 from nmsm.core.term import CostTerm
+from nmsm.core.threads import SOLVER_THREADS
 from nmsm.tools.mtp.context import MtpContext
 from nmsm.tools.mtp.data import TrialData
 from nmsm.tools.mtp.derivatives import blockwise_derivatives
@@ -78,8 +77,8 @@ TASK_MU_INIT = 1e-3
 #: tutorial V1 unchanged (2.1 s).
 TASK_MUMPS_ORDERING = 2
 #: threads of the block-wise Jacobian and Hessian evaluations of :func:`solve_task_problem`
-#: (:func:`nmsm.tools.mtp.derivatives.parallel_sum`): two where the machine has two cores.
-DERIVATIVE_THREADS = min(2, os.cpu_count() or 1)
+#: (:func:`nmsm.tools.mtp.derivatives.parallel_sum`; :data:`nmsm.core.threads.SOLVER_THREADS`).
+DERIVATIVE_THREADS = SOLVER_THREADS
 
 
 @attrs.frozen(eq=False)

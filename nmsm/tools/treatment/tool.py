@@ -8,7 +8,6 @@
 
 from __future__ import annotations
 
-import os
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -19,6 +18,7 @@ import numpy as np
 
 from nmsm.core.registry import get_registry
 from nmsm.core.term import Term, build_terms
+from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
 from nmsm.tools.treatment.bounds import RangeRule, check_guess_within, range_bounds
 from nmsm.tools.treatment.controller_setup import ControllerSetup
@@ -35,9 +35,9 @@ CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMu
 
 
 #: threads of the per-point model functions (CasADi ``map`` with ``thread``
-#: parallelization): two where the machine has two cores. Same iterates as one thread;
+#: parallelization; :data:`nmsm.core.threads.SOLVER_THREADS`). Same iterates as one thread;
 #: measured 2026-11-26: synergy TO V4 29.2 -> 20.4 s, torque TO V2 9.5 -> 7.0 s (docs/treatment.md).
-DEFAULT_PARALLEL = min(2, os.cpu_count() or 1)
+DEFAULT_PARALLEL = SOLVER_THREADS
 
 
 @attrs.define
