@@ -40,6 +40,7 @@ from typing import Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import ModelError
 from nmsm.model.components import GROUND, CoordinateActuator, Model, PointActuator, TorqueActuator
 from nmsm.model.contact_smooth_sphere import ContactResult, contact_force
@@ -118,7 +119,7 @@ class CasadiModel:
             self._cache[key] = f
         return f
 
-    def mapped(self, function: cs.Function, n_frames: int, workers: int = 2) -> cs.Function:
+    def mapped(self, function: cs.Function, n_frames: int, workers: int = SOLVER_THREADS) -> cs.Function:
         """``function`` evaluated over ``n_frames`` frames (columns), in parallel threads."""
         return function.map(n_frames, "thread", workers)
 

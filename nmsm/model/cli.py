@@ -34,6 +34,7 @@ def _markers(args: argparse.Namespace) -> int:
     from nmsm.io.trc import MarkerTable, write_trc
     from nmsm.model import CasadiModel, load_model
     from nmsm.model.id_tool import motion_coordinates
+    from nmsm.core.threads import SOLVER_THREADS
 
     model = load_model(args.model)
     motion = read_storage(args.motion)
@@ -47,7 +48,7 @@ def _markers(args: argparse.Namespace) -> int:
         expanded = cm.coordinates.dependent_values(values)
         values[:, dependent] = expanded[:, dependent]
     n = motion.n_rows
-    positions = np.array(cm.marker_function().map(n, "thread", 2)(values.T))  # 3 x (n_markers * n)
+    positions = np.array(cm.marker_function().map(n, "thread", SOLVER_THREADS)(values.T))  # 3 x (n_markers * n)
     positions = positions.reshape(3, len(model.markers), n, order="F").transpose(2, 1, 0)
     rate = (n - 1) / (motion.time[-1] - motion.time[0]) if n > 1 else None
     table = MarkerTable(motion.time, tuple(model.marker_names), positions, units=args.units, data_rate=rate)

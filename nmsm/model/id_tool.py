@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, table_from_columns
 from nmsm.model.casadi_model import CasadiModel
@@ -115,7 +116,7 @@ def inverse_dynamics_of_motion(
                                  expected="one of " + ", ".join(model.bodies))
         columns.append(_ground_loads(cm, sampled, q))
     function = cm.inverse_dynamics_function(bodies, include_contact=include_contact)
-    tau = np.array(function.map(out_times.size, "thread", 2)(*columns)).T  # (m, n) model order
+    tau = np.array(function.map(out_times.size, "thread", SOLVER_THREADS)(*columns)).T  # (m, n) model order
     order = [model.coordinate_index(name) for name in model.tree_coordinate_names]
     labels = generalized_force_labels(model)
     return table_from_columns(out_times, {label: tau[:, i] for label, i in zip(labels, order)},

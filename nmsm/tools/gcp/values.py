@@ -24,13 +24,10 @@ import casadi as cs
 import numpy as np
 import scipy.sparse
 
+from nmsm.core.threads import thread_map
 from nmsm.tools.gcp.inputs import FootInputs
 from nmsm.tools.gcp.state import Design
 
-#: worker threads of the per-frame map
-MAP_THREADS = 2
-#: options of the per-frame map (see nmsm.tools.gcp.values)
-MAP_OPTIONS: dict = {}
 
 
 @attrs.frozen(eq=False)
@@ -88,7 +85,7 @@ def foot_values(foot: FootInputs, design: Design, index: int, *, coordinates: tu
     """
     q, qdot = coordinates if coordinates is not None else foot_coordinates(foot, design.coefficients[index])
     frames = foot.n_frames
-    mapped = foot.frame_function.map("frames", "thread", frames, [], [], MAP_OPTIONS)
+    mapped = thread_map(foot.frame_function, frames, shared=(2,), name="frames")
     parameters = design.contact_parameters(foot.surface.belt_speed)
     markers, velocities, per_k, offset, springs = mapped(q, qdot, parameters)
     n = foot.springs.n_springs

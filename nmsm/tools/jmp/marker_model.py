@@ -27,6 +27,7 @@ from collections.abc import Collection, Sequence
 import casadi as cs
 import numpy as np
 
+from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.components import GROUND, Model
@@ -143,5 +144,5 @@ class MarkerKinematics:
         q_free = np.atleast_2d(np.asarray(q_free, dtype=float))
         p = self.parameters.initial_values if p is None else np.asarray(p, dtype=float)
         n = q_free.shape[0]
-        out = np.asarray(self.position_function.map(n, "thread", 2)(q_free.T, p))  # 3 x (M n)
+        out = np.asarray(self.position_function.map(n, "thread", SOLVER_THREADS)(q_free.T, p))  # 3 x (M n)
         return out.reshape(3, self.n_markers, n, order="F").transpose(2, 1, 0)

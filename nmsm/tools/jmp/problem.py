@@ -31,6 +31,7 @@ import numpy as np
 
 from nmsm.core.problem import OptimizationProblem
 from nmsm.core.term import CostTerm
+from nmsm.core.threads import SOLVER_THREADS, thread_map
 from nmsm.tools.jmp.dense_evaluator import DenseEvaluator
 from nmsm.tools.jmp.levenberg_marquardt import BlockArrowJacobian, LeastSquaresResult, Tolerances, solve
 from nmsm.tools.jmp.marker_data import MarkerTrial
@@ -90,7 +91,7 @@ class JmpProblem:
     """The least-squares problem of one task (see module docstring)."""
 
     def __init__(self, kinematics: MarkerKinematics, trial: MarkerTrial, terms: Sequence[CostTerm],
-                 p_lower: np.ndarray, p_upper: np.ndarray, *, workers: int = 2) -> None:
+                 p_lower: np.ndarray, p_upper: np.ndarray, *, workers: int = SOLVER_THREADS) -> None:
         if tuple(trial.names) != kinematics.marker_names:
             raise ValueError("the trial's markers and the kinematics' markers differ")
         self.kinematics = kinematics
@@ -113,8 +114,8 @@ class JmpProblem:
         self.n_residuals = int(r.numel())
         self._frame = frame
         # p (input 1) is shared by all frames
-        self._mapped = DenseEvaluator(frame.map("jmp_frames", "thread", n, [1], [], {"max_num_threads": workers}))
-        self._costs = DenseEvaluator(costs.map("jmp_frame_costs", "thread", n, [1], [], {"max_num_threads": workers}))
+        self._mapped = DenseEvaluator(thread_map(frame, n, shared=(1,), threads=workers, name="jmp_frames"))
+        self._costs = DenseEvaluator(thread_map(costs, n, shared=(1,), threads=workers, name="jmp_frame_costs"))
         # column-major inputs: frame after frame (see DenseEvaluator)
         self._x_exp = trial.filled_positions().reshape(n, -1)  # (F, 3M)
         self._sqrt_w = trial.sqrt_weights()  # (F, M)
@@ -189,6 +190,6 @@ class JmpProblem:
         p = problem.variable("p", p0, self.p_lower, self.p_upper, scale=1.0, shape=(self.n_parameters, 1))
         x_exp = problem.parameter("x_exp", self._x_exp.T)
         sqrt_w = problem.parameter("sqrt_w", self._sqrt_w.T)
-        r = self._frame.map(n, "thread", 2)(q, p, x_exp, sqrt_w)[0]
+        r = self._frame.map(n, "thread", SOLVER_THREADS)(q, p, x_exp, sqrt_w)[0]
         problem.add_cost("jmp", r)
         return problem
