@@ -95,3 +95,83 @@ def test_record_never_reaches_outside_or_inputs(tmp_path) -> None:
     results = ResultsDirectory(tmp_path / "out", inputs=[model])
     assert results.retire("trial") == []
     assert model.read_text() == "model"
+
+
+def test_folder_is_created_by_the_first_task_and_removed_if_it_fails(tmp_path) -> None:
+    results = ResultsDirectory(tmp_path / "a" / "b")
+    assert not (tmp_path / "a").exists()
+    with pytest.raises(ValueError):
+        with results.task("t") as stage:
+            (stage / "x.txt").write_text("half")
+            raise ValueError("bad input")
+    assert not (tmp_path / "a").exists()  # nothing left, not even empty folders
+    with results.task("t") as stage:
+        (stage / "x.txt").write_text("done")
+    assert (tmp_path / "a" / "b" / "x.txt").read_text() == "done"
+
+
+def test_a_failing_later_task_keeps_the_folder_and_finished_files(tmp_path) -> None:
+    results = ResultsDirectory(tmp_path / "out")
+    with results.task("one") as stage:
+        (stage / "one.txt").write_text("1")
+    with pytest.raises(ValueError):
+        with results.task("two"):
+            raise ValueError
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["one.txt"]
+
+
+def test_input_folders_are_refused_before_anything_is_written(tmp_path) -> None:
+    data = tmp_path / "preprocessed"
+    (data / "IKData").mkdir(parents=True)
+    folders = {"<data_directory> IKData": data / "IKData"}
+    roots = {"<data_directory>": data}
+    for target, where in [(data / "IKData", "is the"), (data / "IKData" / "run", "is inside the"), (data, "is the")]:
+        with pytest.raises(InputError, match=f"{where} .*: the results would mix"):
+            ResultsDirectory(target, input_folders=folders, input_roots=roots, settings_file=tmp_path / "s.xml")
+    ResultsDirectory(data / "results", input_folders=folders, input_roots=roots)  # a new sub-folder of the root
+    assert sorted(p.name for p in data.iterdir()) == ["IKData"]
+
+
+def test_reserve_refuses_a_known_output_name_before_solving(tmp_path) -> None:
+    model = tmp_path / "model.osim"
+    model.write_text("<OpenSimDocument/>")
+    results = ResultsDirectory(tmp_path, inputs=[model])
+    with pytest.raises(InputError, match="model.osim would overwrite an input file") as info:
+        results.reserve("model.osim", element="<output_model_file>")
+    assert "<output_model_file>" in str(info.value)
+    results.reserve("other.osim")
+
+
+def test_copy_in_of_the_file_itself_does_nothing(tmp_path) -> None:
+    settings = tmp_path / "settings.xml"
+    settings.write_text("<settings/>")
+    results = ResultsDirectory(tmp_path, inputs=[settings])
+    assert results.copy_in(settings) == tmp_path / "settings.xml"
+    assert settings.read_text() == "<settings/>"
+
+
+def test_a_recorded_rerun_retires_the_earlier_run_and_sets_aside_other_files(tmp_path) -> None:
+    out = tmp_path / "out"
+    first = ResultsDirectory(out, record="mtp")
+    with first.task("a") as stage:
+        (stage / "Analysis").mkdir()
+        (stage / "Analysis" / "synx.sto").write_text("run 1")
+        (stage / "model_mtp.osimx").write_text("run 1")
+    with first.task("b") as stage:  # a second task of the same run retires nothing
+        (stage / "settings.xml").write_text("run 1")
+    assert sorted(first.recorded("mtp")) == [Path("Analysis/synx.sto"), Path("model_mtp.osimx"), Path("settings.xml")]
+    (out / "notes.txt").write_text("the user's")
+    (out / "original.sto").write_text("the original tool's")
+    second = ResultsDirectory(out, record="mtp")
+    with pytest.warns(UserWarning) as caught:
+        with second.task("a") as stage:
+            (stage / "model_mtp.osimx").write_text("run 2")
+            (stage / "original.sto").write_text("run 2")
+    messages = " ".join(str(w.message) for w in caught)
+    assert "3 files of the earlier mtp run" in messages and "original.sto" in messages
+    assert (out / "model_mtp.osimx").read_text() == "run 2"
+    assert not (out / "Analysis").exists()  # not looking like the second run's
+    assert (out / "superseded" / "Analysis" / "synx.sto").read_text() == "run 1"
+    assert (out / "superseded" / "replaced" / "original.sto").read_text() == "the original tool's"
+    assert (out / "notes.txt").read_text() == "the user's"
+    assert sorted(second.recorded("mtp")) == [Path("model_mtp.osimx"), Path("original.sto")]

@@ -174,7 +174,11 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
     inputs = [settings.input_model_file, settings.input_motion_file, settings.input_grf_file, path]
     if settings.input_osimx_file is not None:
         inputs.append(settings.input_osimx_file)
-    results = ResultsDirectory(settings.results_directory, inputs=inputs)  # refuses a read-only folder now
+    results = ResultsDirectory(  # refuses a read-only folder or an input folder now
+        settings.results_directory, inputs=inputs, record="gcp", settings_file=path,
+        input_folders={"motion (<input_motion_file>)": Path(settings.input_motion_file).parent,
+                       "ground reactions (<input_grf_file>)": Path(settings.input_grf_file).parent},
+        input_roots={"<input_directory>": settings.input_directory})
     task_terms(settings)
     all_feet, casadi_model, motion, grf, osimx = load_feet(
         settings, spring_locations=Path(spring_locations) if spring_locations is not None else None)

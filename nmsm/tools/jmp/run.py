@@ -39,7 +39,6 @@ from typing import Any
 import attrs
 
 from nmsm.core.results import ResultsDirectory
-from nmsm.errors import InputError
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
 from nmsm.io.storage import write_storage
@@ -138,14 +137,8 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
     out_dir = Path(settings.results_directory)
     inputs = [settings.input_model_file, settings.settings_file, *[t.marker_file_name for t in settings.tasks]]
-    try:
-        results = ResultsDirectory(out_dir, inputs=inputs)
-        if not os.access(results.path, os.W_OK):
-            raise PermissionError(13, "not writable")
-    except OSError as exc:
-        raise InputError(f"cannot write into the results folder {out_dir} ({exc.strerror or exc})",
-                         file=settings.settings_file, element="<results_directory>",
-                         expected="a writable folder (pass results_directory= to write elsewhere)") from exc
+    results = ResultsDirectory(out_dir, inputs=inputs, record="jmp", settings_file=settings.settings_file)
+    results.reserve(settings.output_model_path.name, element="<output_model_file>")  # before solving
     log_lines: list[str] = []
 
     def log(text: str) -> None:

@@ -30,6 +30,7 @@ import numpy as np
 from nmsm.core.results import ResultsDirectory
 from nmsm.core.term import CostTerm, build_terms
 from nmsm.errors import InputError, SolverError
+from nmsm.io.layout import trial_table_folders
 from nmsm.io.osimx import OsimxModel, read_osimx
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
@@ -305,7 +306,14 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
     inputs = [setup.settings.input_model_file, settings_file]
     if setup.settings.input_osimx_file:
         inputs.append(setup.settings.input_osimx_file)
-    results = ResultsDirectory(target, inputs=inputs)
+    settings = setup.settings
+    folders = trial_table_folders(settings.data_directory, "<data_directory>")
+    passive = settings.muscle_tendon_length_initialization.passive_data_input_directory
+    if settings.muscle_tendon_length_initialization.is_enabled and passive is not None:
+        folders.update(trial_table_folders(passive, "<passive_data_input_directory>"))
+    results = ResultsDirectory(target, inputs=inputs, input_folders=folders,
+                               input_roots={"<data_directory>": settings.data_directory}, record="mtp",
+                               settings_file=settings_file)
     _log(verbose, f"{len(setup.data.trials)} trials, {setup.data.muscles.n_muscles} muscles, "
                   f"{len(setup.data.coordinates)} coordinates, SynX {'on' if setup.data.synx else 'off'}")
     start_data, mtli = initialize_lengths(setup)

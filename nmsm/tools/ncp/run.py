@@ -28,6 +28,7 @@ import attrs
 from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError, SolverError
+from nmsm.io.layout import trial_table_folders
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
 from nmsm.tools.ncp.initial_guess import initial_guess
@@ -190,16 +191,21 @@ def run_settings(
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
     _check_writable(Path(settings.results_directory), settings.settings_file)
     setup = load_ncp(settings, enforce_bilateral_symmetry=enforce_bilateral_symmetry)
+    out_dir = Path(settings.results_directory)
+    inputs_used = [settings.input_model_file, settings.settings_file]
+    if setup.osimx_file is not None:
+        inputs_used.append(setup.osimx_file)
+    roots = {"<data_directory>": settings.data_directory}
+    if settings.mtp_results_directory is not None:
+        roots["<mtp_results_directory>"] = settings.mtp_results_directory
+    results = ResultsDirectory(out_dir, inputs=[p for p in inputs_used if p],
+                               input_folders=trial_table_folders(settings.data_directory, "<data_directory>"),
+                               input_roots=roots, record="ncp", settings_file=settings.settings_file)
     options = _ipopt_options(settings, {"max_iter": max_iterations, "tol": tolerance, "print_level": print_level, **ipopt})
     raw, solved = solve(setup, proximal_weight=proximal_weight, **options)
     solution = raw.normalized()
     costs = score(setup.inputs, setup.terms, solution)
     metrics = fit_metrics(setup.inputs, solution)
-    out_dir = Path(settings.results_directory)
-    inputs_used = [settings.input_model_file, settings.settings_file]
-    if setup.osimx_file is not None:
-        inputs_used.append(setup.osimx_file)
-    results = ResultsDirectory(out_dir, inputs=[p for p in inputs_used if p])
     osimx_name = osimx_file_name(setup.osimx_file, settings.input_model_file)
     wall = time.perf_counter() - start
     with results.task("ncp") as stage:

@@ -166,17 +166,19 @@ def _input_files(prepared: Prepared) -> list[Path]:
 
 
 def _check_results_apart(settings: Any, options: TreatmentOptions, prepared: Prepared) -> None:
-    """Refuse, before solving, a results folder that is one of the input folders."""
+    """Refuse, before solving, a results folder that is, or is inside, one of the input folders."""
     path = Path(options.results_directory or settings.results_directory).resolve()
     inputs = {"tracked quantities": prepared.files.tracked_directory,
               "initial guess": prepared.files.initial_directory}
     if options.guess_directory is not None:
         inputs["guess"] = options.guess_directory
     for what, folder in inputs.items():
-        if Path(folder).resolve() == path:
+        folder = Path(folder).resolve()
+        if path == folder or path.is_relative_to(folder):
             element = "<results_directory>" if options.results_directory is None else None
-            raise InputError(f"the results folder {path} is the {what} folder: the results would overwrite the files "
-                             "they are computed from", file=settings.settings_file, element=element,
+            where = "is" if path == folder else "is inside"
+            raise InputError(f"the results folder {path} {where} the {what} folder {folder}: the results would mix "
+                             "with the files they are computed from", file=settings.settings_file, element=element,
                              expected="a results folder apart from the input folders (e.g. results_directory=...)")
 
 
@@ -222,7 +224,7 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
         results = _results_directory(settings, opts, [Path(path), Path(settings.input_model_file),
                                                       *_input_files(prepared)])
     # the IPOPT log is written into a hidden folder of this run, removed however the run ends
-    log_dir = Path(tempfile.mkdtemp(prefix=".ipopt-", dir=results.path)) if results is not None else None
+    log_dir = Path(tempfile.mkdtemp(prefix=".ipopt-", dir=results.ensure())) if results is not None else None
     try:
         return _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
     finally:
@@ -265,7 +267,8 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
         with results.task(trial, record=trial) as stage:
             files = write_solution(stage, tsol, summary=summary, extra_tables=parameter_tables(prepared, tsol))
             files += write_parameter_solution(stage, prepared, tsol)
-            shutil.copy2(path, stage / Path(path).name)
+            if (Path(results.path) / Path(path).name).resolve() != Path(path).resolve():  # not the settings itself
+                shutil.copy2(path, stage / Path(path).name)
             if log is not None and log.is_file():
                 shutil.copy2(log, stage / log.name)
         files = [Path(results.path) / f.relative_to(stage) for f in files]

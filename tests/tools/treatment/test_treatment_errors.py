@@ -176,10 +176,14 @@ def test_results_folder_cannot_be_an_input_folder(shared_data: Path, tmp_path: P
     to = tmp_path / "to"
     _quiet_run(toy / "tracking_optimization" / "TorqueDrivenTOSettings.xml", results_directory=to, print_level=0)
     before = (to / "arm1_states.sto").read_bytes()
-    with pytest.raises(InputError, match="is the tracked quantities folder: the results would overwrite"):
+    with pytest.raises(InputError, match="is the tracked quantities folder .*: the results would mix"):
         _quiet_run(toy / "verification_optimization" / "TorqueDrivenVOSettings.xml", results_directory=to,
                    initial_guess_directory=to, tracked_quantities_directory=to, print_level=0)
+    with pytest.raises(InputError, match="is inside the tracked quantities folder"):
+        _quiet_run(toy / "verification_optimization" / "TorqueDrivenVOSettings.xml", results_directory=to / "vo",
+                   initial_guess_directory=to, tracked_quantities_directory=to, print_level=0)
     assert (to / "arm1_states.sto").read_bytes() == before
+    assert not (to / "vo").exists()
 
 
 def test_failed_rerun_leaves_no_earlier_result_looking_like_its_own(shared_data: Path, tmp_path: Path) -> None:
