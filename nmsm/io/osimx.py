@@ -18,12 +18,23 @@ Compatibility on read:
 
 * OpenSim-style ``<objects>``/``<groups>`` wrappers inside sets (2023 files) are flattened.
 * ``<MTPMuscleSet>`` (2023 MTP output) is read as the muscle set, with a warning; its
-  ``*_scale_factor`` children are not current fields and are kept as unknown elements.
+  ``*_scale_factor`` children are not current fields and are kept as unknown elements
+  (NCP applies them to the model's lengths). The same children in an ``<RCNLMuscleSet>``
+  get one warning per file.
 * Unknown elements are **kept**: each object stores them (``extra``, serialized XML) and the
   writer puts them back at the end of the same element, so nothing a newer or older tool
-  wrote is lost. Comments are descriptive and are not kept.
+  wrote is lost. Each one is reported by a ``UserWarning`` naming the file, the line, the
+  element, its parent and the closest known child of that parent ("did you mean
+  <tendon_slack_length>?"), since a misspelled field or set is otherwise silently unused.
+  Unknown children of a *set* (``RCNLContactSurfaceSet``, ``GCPSpringSet``,
+  ``RCNLSynergySet``) and of the root have no object to live in: they are dropped, with the
+  same warning. Comments are descriptive and are not kept.
 * The old ground-contact layout (``<RCNLGroundContact>``, ``<toes_coordinate>``) is an
   error: GCP must be re-run to name the ``hindfoot_body``.
+
+Applying the muscles to a model (MTP, NCP, treatment muscle and synergy controllers):
+:func:`check_muscles_in_model` makes an ``RCNLMuscle`` that names no muscle of the model an
+``InputError`` (the original ignored it and copied it into its output ``.osimx``).
 """
 
 from __future__ import annotations
@@ -37,6 +48,7 @@ import attrs
 from lxml import etree
 
 from nmsm.errors import InputError
+from nmsm.io.names import close_matches
 from nmsm.io.numbers import significant15
 
 #: version written when the model has none
@@ -60,6 +72,8 @@ class OsimxMuscle:
     tendon_slack_length: float | None = None  #: m, absolute
     max_isometric_force: float | None = None  #: N, absolute
     extra: tuple[str, ...] = attrs.field(default=(), converter=_xml_tuple)
+    #: line of the ``<RCNLMuscle>`` in the file it was read from (None when built in code)
+    line: int | None = attrs.field(default=None, eq=False, repr=False)
 
 
 @attrs.frozen
@@ -117,6 +131,8 @@ class OsimxModel:
     synergies: tuple[OsimxSynergy, ...] = ()
     version: str = OSIMX_VERSION
     extra: tuple[str, ...] = attrs.field(default=(), converter=_xml_tuple)
+    #: the file it was read from (None when built in code or parsed from text)
+    source: Path | None = attrs.field(default=None, eq=False, repr=False)
 
     def model_path(self, osimx_file: str | os.PathLike[str]) -> Path:
         """The associated model, resolved relative to the ``.osimx`` file's folder."""
@@ -152,12 +168,65 @@ _SURFACE_FLOATS = (
     "damping_factor",
     "latching_velocity",
 )
+_SURFACE_FIELDS = ("is_left_foot", "belt_speed", *_SURFACE_COLUMNS, *_SURFACE_TEXT, *_SURFACE_FLOATS)
+_SPRING_FIELDS = ("parent_body", "location", "spring_constant")
+_SYNERGY_FIELDS = ("muscle_group_name", "num_synergies")
+
+#: the children the reader uses, per (current) parent element: anything else is "unknown"
+_KNOWN_CHILDREN: dict[str, tuple[str, ...]] = {
+    "NMSMPipelineDocument": ("OsimxModel",),
+    "OsimxModel": ("associated_osim_model", "RCNLMuscleSet", "RCNLContactSurfaceSet", "RCNLSynergySet"),
+    "RCNLMuscle": _MUSCLE_FIELDS,
+    "RCNLContactSurfaceSet": ("RCNLContactSurface",),
+    "RCNLContactSurface": (*_SURFACE_FIELDS, "GCPSpringSet"),
+    "GCPSpringSet": ("GCPSpring",),
+    "GCPSpring": _SPRING_FIELDS,
+    "RCNLSynergySet": ("RCNLSynergy",),
+    "RCNLSynergy": _SYNERGY_FIELDS,
+}
+#: 2023 root read as the current one (reported by its own warning)
+_OLD_NAMES = {"OpenSimDocument": "NMSMPipelineDocument"}
+#: 2023 ``RCNLMuscle`` children (MTP's length scale factors): kept, applied by NCP, not "unknown"
+_OLD_SCALE_FACTORS = (
+    "optimal_fiber_length_scale_factor",
+    "slack_tendon_length_scale_factor",
+    "tendon_slack_length_scale_factor",
+)
 
 
 # ----- reading ----------------------------------------------------------------------------
 class _Reader:
+    """One read of one file; ``messages`` collects its warnings (emitted by the caller)."""
+
     def __init__(self, path: Path | None) -> None:
         self.path = path
+        self.messages: list[str] = []
+        self.old_scale_factors: list[etree._Element] = []
+
+    def where(self, element: etree._Element) -> str:
+        return f"{self.path if self.path is not None else '(.osimx text)'}:{element.sourceline}"
+
+    def unknown(self, child: etree._Element, parent: etree._Element, *, kept: bool = True) -> None:
+        """Record a warning for ``child``, an element the reader does not use inside ``parent``."""
+        known = _KNOWN_CHILDREN[_OLD_NAMES.get(parent.tag, parent.tag)]
+        close = close_matches(str(child.tag), known, n=1, cutoff=0.75)
+        hint = f"did you mean <{close[0]}>?" if close else "known here: " + ", ".join(f"<{k}>" for k in known)
+        fate = "kept and written back, but not used" if kept else "ignored and not written back"
+        self.messages.append(
+            f"{self.where(child)}: unknown element <{child.tag}> in {_describe(parent)}: {fate} ({hint})"
+        )
+
+    def old_scale_factor_message(self) -> None:
+        """One warning for 2023 length scale factors outside an ``<MTPMuscleSet>``."""
+        if not self.old_scale_factors:
+            return
+        first = self.old_scale_factors[0]
+        self.messages.append(
+            f"{self.where(first)}: {len(self.old_scale_factors)} 2023 length scale factor(s) (first <{first.tag}> in "
+            f"{_describe(first.getparent())}) are not current fields: kept and written back; NCP applies them to "
+            "the model's lengths, MTP and treatment tools do not (current files hold absolute "
+            "<optimal_fiber_length>/<tendon_slack_length>)"
+        )
 
     def error(self, element: etree._Element | None, message: str, expected: str | None = None) -> InputError:
         line = element.sourceline if element is not None else None
@@ -204,7 +273,8 @@ class _Reader:
         except ValueError:
             raise self.error(element, f"'{self.text(element)}' are not numbers", "three numbers") from None
 
-    def muscle(self, element: etree._Element) -> OsimxMuscle:
+    def muscle(self, element: etree._Element, *, old_set: bool = False) -> OsimxMuscle:
+        """One ``RCNLMuscle``; ``old_set``: inside a 2023 ``<MTPMuscleSet>`` (its scale factors already reported)."""
         name = element.get("name")
         if not name:
             raise self.error(element, "muscle without a name attribute", '<RCNLMuscle name="...">')
@@ -213,18 +283,39 @@ class _Reader:
         for child in self.children(element):
             if child.tag in _MUSCLE_FIELDS:
                 values[child.tag] = self.number(child)
+                continue
+            extra.append(_serialize(child))
+            if child.tag not in _OLD_SCALE_FACTORS:
+                self.unknown(child, element)
+            elif not old_set:
+                self.old_scale_factors.append(child)
+        return OsimxMuscle(name=name, extra=tuple(extra), line=element.sourceline, **values)
+
+    def extras(self, element: etree._Element, known: tuple[str, ...]) -> list[str]:
+        """Serialized children of ``element`` not in ``known`` (each one warned about)."""
+        out = []
+        for child in self.children(element):
+            if child.tag not in known:
+                self.unknown(child, element)
+                out.append(_serialize(child))
+        return out
+
+    def members(self, element: etree._Element, tag: str) -> list[etree._Element]:
+        """The ``tag`` children of a set; any other child is warned about and dropped (no object holds it)."""
+        out = []
+        for child in self.children(element):
+            if child.tag == tag:
+                out.append(child)
             else:
-                extra.append(_serialize(child))
-        return OsimxMuscle(name=name, extra=tuple(extra), **values)
+                self.unknown(child, element, kept=False)
+        return out
 
     def spring(self, element: etree._Element) -> GcpSpring:
         found = {c.tag: c for c in self.children(element)}
-        missing = [k for k in ("parent_body", "location", "spring_constant") if k not in found]
+        missing = [k for k in _SPRING_FIELDS if k not in found]
         if missing:
             raise self.error(element, f"spring lacks <{missing[0]}>", "parent_body, location, spring_constant")
-        extra = [
-            _serialize(c) for c in self.children(element) if c.tag not in ("parent_body", "location", "spring_constant")
-        ]
+        extra = self.extras(element, _SPRING_FIELDS)
         return GcpSpring(
             name=element.get("name", ""),
             parent_body=self.text(found["parent_body"]),
@@ -246,13 +337,13 @@ class _Reader:
                     "<hindfoot_body> (osimx.md)",
                 )
             if child.tag == "GCPSpringSet":
-                springs.extend(self.spring(s) for s in self.children(child) if s.tag == "GCPSpring")
-            elif child.tag in ("is_left_foot", "belt_speed", *_SURFACE_TEXT, *_SURFACE_COLUMNS, *_SURFACE_FLOATS):
+                springs.extend(self.spring(s) for s in self.members(child, "GCPSpring"))
+            elif child.tag in _SURFACE_FIELDS:
                 found[child.tag] = child
             else:
+                self.unknown(child, element)
                 extra.append(_serialize(child))
-        required = ("is_left_foot", "belt_speed", *_SURFACE_COLUMNS, *_SURFACE_TEXT, *_SURFACE_FLOATS)
-        for key in required:
+        for key in _SURFACE_FIELDS:
             if key not in found:
                 raise self.error(element, f"contact surface lacks <{key}>", "every contact-surface field (osimx.md)")
         return OsimxContactSurface(
@@ -267,7 +358,7 @@ class _Reader:
 
     def synergy(self, element: etree._Element) -> OsimxSynergy:
         found = {c.tag: c for c in self.children(element)}
-        for key in ("muscle_group_name", "num_synergies"):
+        for key in _SYNERGY_FIELDS:
             if key not in found:
                 raise self.error(element, f"synergy lacks <{key}>", "muscle_group_name and num_synergies")
         count = self.number(found["num_synergies"])
@@ -275,17 +366,19 @@ class _Reader:
             raise self.error(
                 found["num_synergies"], f"num_synergies must be a positive integer, got {count}", "an integer >= 1"
             )
-        extra = [_serialize(c) for c in self.children(element) if c.tag not in ("muscle_group_name", "num_synergies")]
+        extra = self.extras(element, _SYNERGY_FIELDS)
         return OsimxSynergy(self.text(found["muscle_group_name"]), int(count), tuple(extra))
 
     def model(self, root: etree._Element) -> OsimxModel:
         if root.tag == "OpenSimDocument":
-            warnings.warn(
-                f"{self.path}: old .osimx root <OpenSimDocument>; read as <NMSMPipelineDocument>", stacklevel=3
-            )
+            self.messages.append(f"{self.path}: old .osimx root <OpenSimDocument>; read as <NMSMPipelineDocument>")
         elif root.tag != "NMSMPipelineDocument":
             raise self.error(root, f"root element is <{root.tag}>", "<NMSMPipelineDocument> (an .osimx file)")
         models = [c for c in self.children(root) if c.tag == "OsimxModel"]
+        if len(models) == 1:
+            for child in self.children(root):
+                if child.tag != "OsimxModel":
+                    self.unknown(child, root, kept=False)
         if len(models) != 1:
             raise self.error(root, f"{len(models)} <OsimxModel> elements", "exactly one <OsimxModel>")
         element = models[0]
@@ -299,20 +392,20 @@ class _Reader:
                 associated = self.text(child)
             elif child.tag in ("RCNLMuscleSet", "MTPMuscleSet"):
                 if child.tag == "MTPMuscleSet":
-                    warnings.warn(
+                    self.messages.append(
                         f"{self.path}:{child.sourceline}: old <MTPMuscleSet> read as <RCNLMuscleSet>; its scale "
-                        "factors are not current fields and are kept as unknown elements",
-                        stacklevel=3,
+                        "factors are not current fields and are kept as unknown elements (NCP applies them to the "
+                        "model's lengths)"
                     )
                 for m in self.children(child):
                     if m.tag != "RCNLMuscle":
                         raise self.error(m, f"unexpected <{m.tag}> in the muscle set", "<RCNLMuscle> elements")
-                    muscle = self.muscle(m)
+                    muscle = self.muscle(m, old_set=child.tag == "MTPMuscleSet")
                     if muscle.name in muscles:
                         raise self.error(m, f"muscle '{muscle.name}' appears twice", "one entry per muscle")
                     muscles[muscle.name] = muscle
             elif child.tag == "RCNLContactSurfaceSet":
-                surfaces.extend(self.surface(s) for s in self.children(child) if s.tag == "RCNLContactSurface")
+                surfaces.extend(self.surface(s) for s in self.members(child, "RCNLContactSurface"))
             elif child.tag == "RCNLGroundContact":
                 raise self.error(
                     child,
@@ -321,11 +414,13 @@ class _Reader:
                     "<RCNLContactSurfaceSet> (osimx.md)",
                 )
             elif child.tag == "RCNLSynergySet":
-                synergies.extend(self.synergy(s) for s in self.children(child) if s.tag == "RCNLSynergy")
+                synergies.extend(self.synergy(s) for s in self.members(child, "RCNLSynergy"))
             else:
+                self.unknown(child, element)
                 extra.append(_serialize(child))
         if associated is None:
             raise self.error(element, "missing <associated_osim_model>", "the path of the .osim model")
+        self.old_scale_factor_message()
         return OsimxModel(
             name=element.get("name", ""),
             associated_osim_model=associated,
@@ -334,7 +429,21 @@ class _Reader:
             synergies=tuple(synergies),
             version=root.get("Version", OSIMX_VERSION),
             extra=tuple(extra),
+            source=self.path,
         )
+
+    def read(self, root: etree._Element) -> OsimxModel:
+        """The model of ``root``; the warnings of the read are emitted (to the caller's caller) at the end."""
+        model = self.model(root)
+        for message in self.messages:
+            warnings.warn(message, stacklevel=3)
+        return model
+
+
+def _describe(element: etree._Element) -> str:
+    """``<tag>``, or ``<tag name="...">`` when the element has a name."""
+    name = element.get("name")
+    return f'<{element.tag} name="{name}">' if name else f"<{element.tag}>"
 
 
 def _serialize(element: etree._Element) -> str:
@@ -352,7 +461,7 @@ def read_osimx(path: str | os.PathLike[str]) -> OsimxModel:
         raise InputError(f"cannot read .osimx file: {exc}", file=path, expected="a readable .osimx file") from exc
     except etree.XMLSyntaxError as exc:
         raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from exc
-    return _Reader(path).model(root)
+    return _Reader(path).read(root)
 
 
 def parse_osimx(text: str | bytes, *, source: Path | None = None) -> OsimxModel:
@@ -363,7 +472,45 @@ def parse_osimx(text: str | bytes, *, source: Path | None = None) -> OsimxModel:
         )
     except etree.XMLSyntaxError as exc:
         raise InputError(f"malformed XML: {exc.msg}", file=source, line=exc.lineno, expected="well-formed XML") from exc
-    return _Reader(source).model(root)
+    return _Reader(source).read(root)
+
+
+# ----- applying to a model ----------------------------------------------------------------
+def check_muscles_in_model(
+    osimx: OsimxModel,
+    model_muscles: Iterable[str],
+    *,
+    model_file: str | os.PathLike[str] | None = None,
+    osimx_file: str | os.PathLike[str] | None = None,
+) -> None:
+    """Raise :class:`InputError` if an ``RCNLMuscle`` of ``osimx`` names no muscle of the model.
+
+    Called where an ``.osimx``'s muscles are applied to a model by name (MTP, NCP, treatment
+    controllers): such an entry is a typo or an ``.osimx`` of another model, and would
+    otherwise be silently unused (and copied into the tool's output ``.osimx``). The error
+    names the ``.osimx`` (``osimx_file``, default the file it was read from), the line of the
+    first such muscle, close matches among ``model_muscles`` and the other unknown names.
+    An ``.osimx`` holding a *subset* of the model's muscles is fine (the others keep the
+    model's values).
+    """
+    known = list(model_muscles)
+    present = set(known)
+    unknown = [m for m in osimx.muscles.values() if m.name not in present]
+    if not unknown:
+        return
+    first = unknown[0]
+    close = close_matches(first.name, known, n=3)
+    hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+    others = f"; also not in the model: {', '.join(m.name for m in unknown[1:])}" if len(unknown) > 1 else ""
+    model = f"the model {model_file}" if model_file is not None else "the model"
+    shown = ", ".join(known[:12]) + (f", ... ({len(known)} muscles)" if len(known) > 12 else "")
+    raise InputError(
+        f"muscle '{first.name}' is not in {model}{hint}{others}",
+        file=osimx_file if osimx_file is not None else osimx.source,
+        line=first.line,
+        element=f'<RCNLMuscle name="{first.name}">',
+        expected=f"RCNLMuscle names that are muscles of the model: {shown}",
+    )
 
 
 # ----- writing ----------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from nmsm.io.osimx import (
     OsimxModel,
     OsimxMuscle,
     OsimxSynergy,
+    check_muscles_in_model,
     format_osimx,
     parse_osimx,
     read_osimx,
@@ -61,10 +62,10 @@ def test_every_shared_osimx_reads_and_round_trips(shared_data: Path, tmp_path: P
                 read_osimx(path)
             continue
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # OpenSimDocument roots and MTPMuscleSet warn
+            warnings.simplefilter("ignore")  # OpenSimDocument roots, MTPMuscleSet and their scale factors warn
             model = read_osimx(path)
-        copy = write_osimx(tmp_path / "copy.osimx", model)
-        assert read_osimx(copy) == model, relative
+            copy = write_osimx(tmp_path / "copy.osimx", model)
+            assert read_osimx(copy) == model, relative
         assert _leaves(copy) == _leaves(path), relative  # every element and value kept
         read += 1
     assert read == 17
@@ -149,11 +150,14 @@ def test_unknown_elements_are_kept_where_they_were(tmp_path: Path) -> None:
         )
         .replace("</OsimxModel>", "<RCNLJointSet><joint name='knee'>1</joint></RCNLJointSet></OsimxModel>")
     )
-    model = parse_osimx(text)
+    with pytest.warns(UserWarning, match="unknown element") as record:
+        model = parse_osimx(text)
+    assert len(record) == 2
     assert model.muscles["soleus_r"].extra == ('<future_field unit="s">3</future_field>',)
     assert "RCNLJointSet" in model.extra[0]
     path = write_osimx(tmp_path / "k.osimx", model)
-    again = read_osimx(path)
+    with pytest.warns(UserWarning, match="unknown element"):
+        again = read_osimx(path)
     assert again == model
     root = etree.parse(str(path)).getroot()
     assert root.find(".//RCNLMuscle[@name='soleus_r']/future_field").text == "3"
@@ -191,3 +195,146 @@ def test_model_path_resolves_relative_to_the_osimx_file(tmp_path: Path) -> None:
     (tmp_path / "subject.osim").write_text("<OpenSimDocument/>")
     path = write_osimx(tmp_path / "s.osimx", _model())
     assert read_osimx(path).model_path(path) == (tmp_path / "subject.osim").resolve()
+
+
+# ----- warnings for unknown elements ------------------------------------------------------
+def _read_recording(path: Path) -> tuple[OsimxModel, list[str]]:
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        model = read_osimx(path)
+    return model, [str(w.message) for w in record if issubclass(w.category, UserWarning)]
+
+
+def _line_of(path: Path, text: str) -> int:
+    return next(i for i, line in enumerate(path.read_text().splitlines(), start=1) if text in line)
+
+
+def test_misspelled_field_warns_with_file_line_parent_and_close_match(tmp_path: Path) -> None:
+    text = format_osimx(_model()).replace("tendon_slack_length>", "tendon_slack_lenght>")
+    path = tmp_path / "typo.osimx"
+    path.write_text(text)
+    model, messages = _read_recording(path)
+    (message,) = messages
+    line = _line_of(path, "<tendon_slack_lenght>")
+    assert message.startswith(f"{path}:{line}: unknown element <tendon_slack_lenght>")
+    assert '<RCNLMuscle name="soleus_r">' in message and "did you mean <tendon_slack_length>?" in message
+    assert model.muscles["soleus_r"].tendon_slack_length is None  # not used ...
+    assert "tendon_slack_lenght" in model.muscles["soleus_r"].extra[0]  # ... but kept
+    again, _ = _read_recording(write_osimx(tmp_path / "again.osimx", model))
+    assert again == model  # and written back
+
+
+def test_misspelled_muscle_set_warns_and_is_kept(tmp_path: Path) -> None:
+    path = tmp_path / "set.osimx"
+    path.write_text(format_osimx(_model()).replace("RCNLMuscleSet>", "RCNLMusclesSet>"))
+    model, messages = _read_recording(path)
+    (message,) = messages
+    assert f"{path}:{_line_of(path, '<RCNLMusclesSet>')}: unknown element <RCNLMusclesSet>" in message
+    assert '<OsimxModel name="subject">' in message and "did you mean <RCNLMuscleSet>?" in message
+    assert not model.muscles and "RCNLMusclesSet" in model.extra[0]
+
+
+def test_unknown_set_member_warns_and_is_dropped(tmp_path: Path) -> None:
+    path = tmp_path / "m.osimx"
+    path.write_text(format_osimx(_model()).replace("RCNLSynergy>", "RCNLSynergyy>"))
+    model, messages = _read_recording(path)
+    (message,) = messages
+    assert f"{path}:{_line_of(path, '<RCNLSynergyy>')}: unknown element <RCNLSynergyy> in <RCNLSynergySet>" in message
+    assert "ignored and not written back (did you mean <RCNLSynergy>?)" in message
+    assert not model.synergies
+
+
+def test_unknown_spring_child_warns(tmp_path: Path) -> None:
+    path = tmp_path / "s.osimx"
+    path.write_text(format_osimx(_model()).replace("<parent_body>", "<stiffness>1</stiffness><parent_body>"))
+    model, messages = _read_recording(path)
+    (message,) = messages
+    assert '<stiffness> in <GCPSpring name="spring_marker_1">: kept and written back' in message
+    assert "known here: <parent_body>, <location>, <spring_constant>" in message
+    assert model.contact_surfaces[0].springs[0].extra == ("<stiffness>1</stiffness>",)
+
+
+def test_text_without_a_file_names_the_text() -> None:
+    with pytest.warns(UserWarning, match=r"^\(\.osimx text\):\d+: unknown element <future>"):
+        parse_osimx(format_osimx(_model()).replace("</OsimxModel>", "<future/></OsimxModel>"))
+
+
+def test_written_osimx_reads_without_warnings(tmp_path: Path) -> None:
+    path = write_osimx(tmp_path / "m.osimx", _model())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert format_osimx(read_osimx(path)) == format_osimx(_model())
+
+
+@pytest.mark.shared_data
+def test_shared_osimx_files_warn_only_about_old_layouts(shared_data: Path) -> None:
+    """Current files read silently; 2023 files get their two layout warnings, no "unknown element"."""
+    silent = 0
+    for path in sorted(shared_data.rglob("*.osimx")):
+        if path.relative_to(shared_data).as_posix() in OLD_CONTACT_LAYOUT:
+            continue
+        _, messages = _read_recording(path)
+        if etree.parse(str(path)).getroot().tag == "NMSMPipelineDocument":
+            assert messages == [], path
+            silent += 1
+        else:
+            assert len(messages) == 2 and "<OpenSimDocument>" in messages[0] and "<MTPMuscleSet>" in messages[1], path
+    assert silent == 15
+
+
+def test_old_scale_factors_outside_mtp_muscle_set_warn_once(tmp_path: Path) -> None:
+    factor = "<optimal_fiber_length_scale_factor>1.1</optimal_fiber_length_scale_factor>"
+    path = tmp_path / "old.osimx"
+    path.write_text(format_osimx(_model()).replace("</RCNLMuscle>", factor + "</RCNLMuscle>"))
+    model, messages = _read_recording(path)
+    (message,) = messages
+    assert "2 2023 length scale factor(s)" in message and "unknown element" not in message
+    assert all("scale_factor" in m.extra[-1] for m in model.muscles.values())
+    path.write_text(path.read_text().replace("RCNLMuscleSet", "MTPMuscleSet"))
+    _, messages = _read_recording(path)
+    (message,) = messages  # the <MTPMuscleSet> warning covers its scale factors
+    assert "old <MTPMuscleSet>" in message
+
+
+# ----- muscles applied to a model ---------------------------------------------------------
+def test_muscle_not_in_model_is_an_error_naming_file_line_and_close_matches(tmp_path: Path) -> None:
+    path = tmp_path / "m.osimx"
+    path.write_text(format_osimx(_model()).replace('name="tibant_r"', 'name="tib_ant_r"'))
+    osimx = read_osimx(path)
+    check_muscles_in_model(osimx, ["soleus_r", "tib_ant_r", "gasmed_r"])  # a subset of the model is fine
+    with pytest.raises(InputError) as info:
+        check_muscles_in_model(osimx, ["soleus_r", "tibant_r", "gasmed_r"], model_file="subject.osim")
+    error = info.value
+    assert error.file == str(path) and error.line == _line_of(path, 'name="tib_ant_r"')
+    assert error.element == '<RCNLMuscle name="tib_ant_r">'
+    assert "muscle 'tib_ant_r' is not in the model subject.osim; did you mean 'tibant_r'?" in str(error)
+    assert "muscles of the model: soleus_r, tibant_r, gasmed_r" in str(error)
+
+
+def test_every_muscle_not_in_model_is_named() -> None:
+    osimx = _model()  # built in code: no file, no line
+    with pytest.raises(InputError) as info:
+        check_muscles_in_model(osimx, ["vasmed_r"], osimx_file="given.osimx")
+    assert info.value.file == "given.osimx" and info.value.line is None
+    message = str(info.value)
+    assert "muscle 'soleus_r' is not in the model" in message and "also not in the model: tibant_r" in message
+
+
+@pytest.mark.shared_data
+def test_treatment_muscle_model_rejects_an_osimx_muscle_not_in_the_model(shared_data: Path, tmp_path: Path) -> None:
+    from nmsm.controllers.muscle import PathGeometry
+    from nmsm.examples.moco2d import MUSCLE_COORDINATES
+    from nmsm.model import load_model
+    from nmsm.tools.treatment.muscles import MuscleModel
+
+    model = load_model(shared_data / "moco2d" / "2D_gait.osim")
+    names = [m.name for m in model.muscles]
+    geometry = PathGeometry(model, MUSCLE_COORDINATES)
+    good = OsimxModel("m", "2D_gait.osim", {names[0]: OsimxMuscle(names[0], max_isometric_force=1234.0)})
+    built = MuscleModel.build(names, MUSCLE_COORDINATES, geometry, model, good, 10.0)
+    assert built.parameters[names[0]]["max_isometric_force"] == 1234.0
+    typo = names[0] + "x"
+    path = write_osimx(tmp_path / "bad.osimx", OsimxModel("m", "2D_gait.osim", {typo: OsimxMuscle(typo)}))
+    with pytest.raises(InputError) as info:
+        MuscleModel.build(names, MUSCLE_COORDINATES, geometry, model, read_osimx(path), 10.0)
+    assert str(path) in str(info.value) and f"did you mean '{names[0]}'" in str(info.value)

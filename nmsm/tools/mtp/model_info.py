@@ -3,7 +3,7 @@
 Muscle set (``getMusclesFromCoordinates``): force-applying muscles with a path point on
 the child body of a joint that owns a listed coordinate, in the model's muscle order.
 Parameters come from the model, overridden by an ``.osimx`` ``RCNLMuscle`` entry of the
-same name when it has the value.
+same name when it has the value; an entry naming no muscle of the model is an error.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from nmsm.errors import InputError
-from nmsm.io.osimx import OsimxModel
+from nmsm.io.osimx import OsimxModel, check_muscles_in_model
 from nmsm.model.components import Model
 from nmsm.tools.mtp.muscles import MuscleParameters
 
@@ -45,7 +45,13 @@ def muscles_crossing(model: Model, coordinates: Sequence[str]) -> list[str]:
 
 
 def muscle_parameters(model: Model, names: Sequence[str], osimx: OsimxModel | None = None) -> MuscleParameters:
-    """Parameters (N, m, rad) of ``names`` from the model, with ``.osimx`` values taking precedence."""
+    """Parameters (N, m, rad) of ``names`` from the model, with ``.osimx`` values taking precedence.
+
+    Every ``RCNLMuscle`` of the ``.osimx`` must be a muscle of the model (``InputError``
+    otherwise); it may hold muscles the tool does not use (``names`` is a subset).
+    """
+    if osimx is not None:
+        check_muscles_in_model(osimx, model.muscle_names, model_file=model.file)
     f0, lo, lts, alpha = [], [], [], []
     for name in names:
         muscle = model.muscle(name)

@@ -24,7 +24,7 @@ import numpy as np
 
 from nmsm.core.term import Term, build_terms
 from nmsm.errors import InputError
-from nmsm.io.osimx import OsimxModel, read_osimx
+from nmsm.io.osimx import OsimxModel, check_muscles_in_model, read_osimx
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
 from nmsm.io.storage import read_storage
 from nmsm.io.trials import find_trial_file
@@ -103,8 +103,11 @@ def _muscle_parameters(model: Model, muscles: Sequence[str], osimx: OsimxModel |
 
     Current ``.osimx`` files hold absolute l_o, l_ts, F0; 2023 files hold l_o and l_ts scale
     factors (``optimal_fiber_length_scale_factor``, ``slack_tendon_length_scale_factor``), applied
-    to the model's values here.
+    to the model's values here. Every ``RCNLMuscle`` must be a muscle of the model
+    (``InputError`` otherwise).
     """
+    if osimx is not None:
+        check_muscles_in_model(osimx, model.muscle_names, model_file=model.file)
     f0, lo, lts, alpha = [], [], [], []
     scaled = 0
     for name in muscles:

@@ -9,7 +9,8 @@ Hill model (:mod:`nmsm.model.hill`)::
 
 Parameters per muscle: ``max_isometric_force`` F0 (N), ``optimal_fiber_length`` l_o (m),
 ``tendon_slack_length`` l_ts (m) from the ``.osimx`` when it has them (matched by name; the
-original matches by list position, a bug) else from the ``.osim``; pennation α (rad) from the
+original matches by list position, a bug; an ``.osimx`` muscle that the model lacks is an
+error) else from the ``.osim``; pennation α (rad) from the
 ``.osim``; ``vmax`` = ``maximum_shortening_velocity_multiplier`` (l_o/s). Parameters may be
 replaced by CasADi expressions (Design Optimization model modifiers).
 """
@@ -27,6 +28,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.errors import InputError
+from nmsm.io.osimx import OsimxModel, check_muscles_in_model
 from nmsm.model import hill
 from nmsm.model.surrogate import SurrogateModel
 from nmsm.tools.treatment.transcription.base import map_rows
@@ -86,6 +88,8 @@ class MuscleModel:
         params: dict[str, dict[str, Any]] = {}
         pennation = []
         overrides = getattr(osimx, "muscles", {}) if osimx is not None else {}
+        if isinstance(osimx, OsimxModel):
+            check_muscles_in_model(osimx, osim_model.muscle_names, model_file=getattr(osim_model, "file", None))
         for name in muscles:
             try:
                 muscle = osim_model.muscle(name)

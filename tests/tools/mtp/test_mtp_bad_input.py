@@ -141,7 +141,7 @@ def test_tiny_tendon_slack_length_gives_finite_results(case):
     osimx = folder / "tiny.osimx"
     osimx.write_text("""<NMSMPipelineDocument Version="1.5.3"><OsimxModel name="m">
  <associated_osim_model>m.osim</associated_osim_model><RCNLMuscleSet>
- <RCNLMuscle name="tib_ant_r"><tendon_slack_length>1e-6</tendon_slack_length></RCNLMuscle>
+ <RCNLMuscle name="tibant_r"><tendon_slack_length>1e-6</tendon_slack_length></RCNLMuscle>
  </RCNLMuscleSet></OsimxModel></NMSMPipelineDocument>""")
     settings = write_settings(folder, tutorial, osimx=str(osimx))
     with warnings.catch_warnings():
