@@ -1,4 +1,10 @@
-"""Sub-commands ``nmsm print-xml TOOL`` and ``nmsm upgrade-settings OLD.xml -o NEW.xml``."""
+"""Sub-commands ``nmsm print-xml TOOL [-o FILE [--force]]`` and ``nmsm upgrade-settings OLD.xml -o NEW.xml
+[--force]``.
+
+``-o`` must name a file in an existing folder; an existing file is replaced only with
+``--force``; ``upgrade-settings`` never writes over the old file or a file it names, and both
+write atomically (:mod:`nmsm.io.settings.output_file`).
+"""
 
 from __future__ import annotations
 
@@ -14,12 +20,15 @@ TOOL_CODES = {code: element for element, code in TOOL_ELEMENTS.items()}
 
 
 def _print_xml(args: argparse.Namespace) -> int:
+    from nmsm.io.settings.output_file import check_output, write_output
     from nmsm.io.settings.template import format_template
 
     text = format_template(TOOL_CODES[args.tool])
     if args.output:
-        Path(args.output).write_text(text, encoding="utf-8")
-        print(f"wrote {args.output}", file=sys.stderr)
+        path = check_output(args.output, force=args.force, example_name=f"{args.tool}.xml")
+        replaced = path.exists()
+        write_output(path, text)
+        print(f"wrote {args.output}" + (" (replaced the existing file: --force)" if replaced else ""), file=sys.stderr)
     else:
         sys.stdout.write(text)
     return 0
@@ -28,11 +37,12 @@ def _print_xml(args: argparse.Namespace) -> int:
 def _upgrade_settings(args: argparse.Namespace) -> int:
     from nmsm.io.settings.upgrade import upgrade_settings_file
 
-    result = upgrade_settings_file(args.old, args.output)
+    replaced = " (replaced the existing file: --force)" if Path(args.output).is_file() else ""
+    result = upgrade_settings_file(args.old, args.output, force=args.force)
     if result.schema == "current":
-        print(f"{args.old} already uses the current schema; copied to {args.output}", file=sys.stderr)
+        print(f"{args.old} already uses the current schema; copied to {args.output}{replaced}", file=sys.stderr)
         return 0
-    print(f"{args.old}: schema {result.schema} -> current; wrote {args.output}", file=sys.stderr)
+    print(f"{args.old}: schema {result.schema} -> current; wrote {args.output}{replaced}", file=sys.stderr)
     for note in result.notes:
         print(f"  {note}", file=sys.stderr)
     return 0
@@ -44,7 +54,8 @@ def register(subparsers: Any) -> None:
         help="write a commented settings template of a tool (defaults and descriptions)",
     )
     p.add_argument("tool", choices=list(TOOL_CODES), help="jmp, mtp, ncp, gcp, to, vo, do or solver")
-    p.add_argument("-o", "--output", help="file to write (default: standard output)")
+    p.add_argument("-o", "--output", help="file to write (default: standard output); its folder must exist")
+    p.add_argument("--force", action="store_true", help="replace the -o file if it exists")
     p.set_defaults(func=_print_xml)
 
     p = subparsers.add_parser(
@@ -52,5 +63,9 @@ def register(subparsers: Any) -> None:
         help="translate an older settings file (OpenSimDocument, 0.1.0, GpopsDocument) to the current schema",
     )
     p.add_argument("old", help="settings XML in an older schema")
-    p.add_argument("-o", "--output", required=True, help="where to write the upgraded settings (not the old file)")
+    p.add_argument("-o", "--output", required=True,
+                   help="where to write the upgraded settings: a new file in an existing folder (never the old file "
+                        "or a file it names)")
+    p.add_argument("--force", action="store_true",
+                   help="replace the -o file if it exists (still never the old file or a file it names)")
     p.set_defaults(func=_upgrade_settings)

@@ -192,22 +192,100 @@ def _note_missing_required(up: Upgrader) -> None:
             up.note(tool, f"<{tag}> is required by the current schema and the old file has no equivalent: add it")
 
 
-def upgrade_settings_file(source: str | os.PathLike[str], destination: str | os.PathLike[str]) -> UpgradeResult:
-    """Write the current-schema form of ``source`` to ``destination`` (never over ``source``)."""
+def _output_elements(tool_tag: str) -> set[str]:
+    """Element names the current settings class of ``tool_tag`` declares as outputs (results folders)."""
+    from nmsm.io.settings import SETTINGS_CLASSES
+    from nmsm.io.settings.schema import settings_fields
+
+    names = {"results_directory"}
+    pending = [SETTINGS_CLASSES.get(tool_tag)]
+    seen: set[type] = set()
+    while pending:
+        cls = pending.pop()
+        if cls is None or cls in seen:
+            continue
+        seen.add(cls)
+        for _, spec in settings_fields(cls):
+            if spec.kind == "path" and spec.output:
+                names.add(spec.element)
+            if spec.nested is not None:
+                pending.append(spec.nested)
+    return names
+
+
+def referenced_paths(roots: list[etree._Element], source: Path) -> tuple[dict[Path, str], dict[Path, str]]:
+    """The existing files and input folders that the settings trees ``roots`` (the old file
+    and its upgraded form) name, as nmsm resolves them from ``source``'s folder:
+    ``({file: what it is}, {folder: what it is})``. Every element whose text names an
+    existing file counts (solver settings, model, data files); folders count unless the
+    element is a results folder."""
+    import warnings
+
+    from nmsm.io.paths import resolve_path
+
+    files: dict[Path, str] = {}
+    folders: dict[Path, str] = {}
+    outputs: set[str] = {"results_directory"}
+    for root in roots:
+        tool = next(elements(root), None)
+        if tool is not None:
+            outputs |= _output_elements(str(tool.tag))
+    for root in roots:
+        for element in root.iter():
+            if not isinstance(element.tag, str) or len(element) or element is root:
+                continue
+            text = (element.text or "").strip()
+            if not text or "\n" in text or len(text) > 4096 or text in ("true", "false") or _is_number(text):
+                continue
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    found = resolve_path(text, settings_file=source, must_exist=True, kind="any")
+            except (InputError, OSError, ValueError):
+                continue
+            where = f"<{element.tag}>" + (f" (line {element.sourceline})" if element.sourceline else "")
+            if found.is_file():
+                files.setdefault(found, f"the file {source.name} names in {where}")
+            elif found.is_dir() and element.tag not in outputs:
+                folders.setdefault(found, f"the folder {source.name} names in {where}")
+    return files, folders
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def upgrade_settings_file(
+    source: str | os.PathLike[str], destination: str | os.PathLike[str], *, force: bool = False
+) -> UpgradeResult:
+    """Write the current-schema form of ``source`` to ``destination``.
+
+    Refused (:class:`InputError`, nothing written): ``destination`` is ``source`` itself (in
+    any spelling or link form) or a file ``source`` names (its solver settings, model, data),
+    or an existing file inside a data folder it names; an existing ``destination`` without
+    ``force``; a missing folder; a folder. The file is written atomically
+    (:mod:`nmsm.io.settings.output_file`).
+    """
     from nmsm.io.settings.document import parse_settings_xml
+    from nmsm.io.settings.output_file import check_output, write_output
 
     source, destination = Path(source), Path(destination)
-    if destination.resolve() == source.resolve():
-        raise InputError(
-            "the upgraded file would overwrite the old one", file=destination, expected="another output file name"
-        )
+    itself = {source: "the settings file being upgraded (this name, a link or another spelling of it)"}
+    check_output(destination, force=True, protected=itself, example_name=f"{source.stem}_upgraded.xml")
     root = parse_settings_xml(source)
     result = upgrade_tree(root, source)
+    files, folders = referenced_paths([root, result.root], source)
+    check_output(destination, force=force, protected={**itself, **files}, protected_folders=folders,
+                 example_name=f"{source.stem}_upgraded.xml")
     tree = result.root
     etree.indent(tree, space="\t")
     header = f"<!-- Upgraded by nmsm upgrade-settings from {source.name} (schema {result.schema}). -->\n"
     if result.schema == "current":
         header = f"<!-- {source.name} already uses the current schema; copied by nmsm upgrade-settings. -->\n"
     text = etree.tostring(tree, encoding="unicode")
-    destination.write_text(header + text + "\n", encoding="utf-8")
+    write_output(destination, header + text + "\n")
     return result

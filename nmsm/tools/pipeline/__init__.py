@@ -9,8 +9,9 @@ Modules (one job each):
 ``stage_settings``    a stage's settings tree: path elements found, rewired, made absolute, hashed
 ``wiring``            rewriting a stage's inputs to earlier stages' outputs
 ``plan``              checks before running: stage order, every stage's inputs
+``validation``        checks before running: each stage's settings as its tool reads them (terms too)
 ``hashing``           content digests of files and folders
-``state``             ``pipeline_state.json``: records of finished stages
+``state``             ``pipeline_state.json``: records of finished stages; the stage-folder marker
 ``outputs``           where each kind of stage leaves its outputs
 ``runner``            running a pipeline, skipping up-to-date stages, resuming after a stop
 ``native``            reading the pipeline's own settings files (and ``nmsm run`` on them)

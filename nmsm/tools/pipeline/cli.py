@@ -65,8 +65,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("--until", metavar="STAGE", help="stop after this stage")
     p.add_argument("--only", metavar="STAGE", nargs="+", help="run only these stages (others must be up to date)")
     p.add_argument("--force", metavar="STAGE", nargs="+", help="redo these stages even when up to date")
-    p.add_argument("--rebuild", action="store_true", help="redo every stage")
-    p.add_argument("--check", action="store_true", help="check the file and show what would run, run nothing")
+    p.add_argument("--rebuild", action="store_true",
+                   help="redo every stage (also the way out of a damaged pipeline_state.json)")
+    p.add_argument("--check", action="store_true",
+                   help="check the file and every stage's settings, show what would run and how it is wired; "
+                        "run and write nothing")
     p.set_defaults(func=_pipeline)
 
     p = subparsers.add_parser("example", help="the built-in synthetic subject: lab data to treatment, with the "

@@ -10,7 +10,10 @@ A stage kind is identified by its settings tool element. It declares:
 * ``wires``: which settings element receives which artifact (the runner rewrites it), and
   ``hook`` for wiring that depends on the settings (the treatment's initial guess);
 * ``produces`` and :attr:`StageKind.outputs`: where its outputs are found after a run;
-* ``run``: ``"module:function"`` called as ``function(settings_file, **options)``.
+* ``run``: ``"module:function"`` called as ``function(settings_file, **options)``;
+* ``validate``: optional ``"module:function"`` called with the parsed settings before
+  anything runs (:mod:`nmsm.tools.pipeline.validation`: term types, solver settings), beyond
+  what the settings class itself checks.
 
 ================  ================================  =====  =========================================
 code              tool element                      order  produces
@@ -75,6 +78,7 @@ class StageKind:
     wires: tuple[Wire, ...] = ()
     hook: str | Callable[..., Any] | None = None  #: (StageSettings, Artifacts, kept keys) -> {key: source}
     run_options: Mapping[str, Any] = attrs.field(factory=dict)
+    validate: str | Callable[[Any], None] | None = None  #: checks of the parsed settings (module docstring)
 
     def load_settings_class(self) -> type:
         return _load(self.settings_class)
@@ -84,6 +88,9 @@ class StageKind:
 
     def load_outputs(self) -> OutputsFunction:
         return _load(self.outputs)
+
+    def load_validate(self) -> Callable[[Any], None] | None:
+        return None if self.validate is None else _load(self.validate)
 
     def load_hook(self) -> Callable[..., Any] | None:
         return None if self.hook is None else _load(self.hook)
@@ -106,6 +113,7 @@ _PERSONALIZATION_WIRES = (
 )
 _TREATMENT_SETTINGS = "nmsm.io.settings.treatment:"
 _OUT = "nmsm.tools.pipeline.outputs:"
+_CHECK = "nmsm.tools.pipeline.validation:"
 
 _BUILT_IN = (
     StageKind("jmp", "Joint Model Personalization", "JointModelPersonalizationTool", 10,
@@ -124,19 +132,19 @@ _BUILT_IN = (
     StageKind("mtp", "Muscle-Tendon Personalization", "MuscleTendonPersonalizationTool", 40,
               "nmsm.io.settings.mtp:MuscleTendonPersonalizationSettings", "nmsm.tools.mtp.run:run_settings",
               _OUT + "mtp_outputs", requires=("model", "data_directory"), uses=("osimx",),
-              produces=("osimx", "mtp_results"), wires=_PERSONALIZATION_WIRES),
+              produces=("osimx", "mtp_results"), wires=_PERSONALIZATION_WIRES, validate=_CHECK + "mtp"),
     StageKind("ncp", "Neural Control Personalization", "NeuralControlPersonalizationTool", 50,
               "nmsm.io.settings.ncp:NeuralControlPersonalizationSettings", "nmsm.tools.ncp.run:run_settings",
               _OUT + "ncp_outputs", requires=("model", "data_directory"), uses=("osimx", "mtp_results"),
               produces=("osimx", "ncp_results"),
               wires=(*_PERSONALIZATION_WIRES, Wire("mtp_results", "mtp_results_directory")),
-              run_options={"print_level": 0}),
+              run_options={"print_level": 0}, validate=_CHECK + "ncp"),
     StageKind("gcp", "Ground Contact Personalization", "GroundContactPersonalizationTool", 60,
               "nmsm.io.settings.gcp:GroundContactPersonalizationSettings", "nmsm.tools.gcp.run:run_settings",
               _OUT + "gcp_outputs", requires=("model", "data_directory"), uses=("osimx",),
               produces=("osimx", "gcp_results"),
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
-                     Wire("data_directory", "input_directory"))),
+                     Wire("data_directory", "input_directory")), validate=_CHECK + "gcp"),
     StageKind("surrogate", "Surrogate muscle-geometry data", "SurrogateDataTool", 70,
               "nmsm.tools.pipeline.surrogate_settings:SurrogateDataSettings",
               "nmsm.tools.pipeline.surrogate_stage:run_settings", _OUT + "surrogate_outputs",
@@ -149,7 +157,8 @@ _BUILT_IN = (
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
                      Wire("data_directory", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", run_options={"print_level": 0}),
+              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", run_options={"print_level": 0},
+              validate=_CHECK + "treatment"),
     StageKind("vo", "Verification Optimization", "VerificationOptimizationTool", 90,
               _TREATMENT_SETTINGS + "VerificationOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -158,7 +167,7 @@ _BUILT_IN = (
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              run_options={"print_level": 0}),
+              run_options={"print_level": 0}, validate=_CHECK + "treatment"),
     StageKind("do", "Design Optimization", "DesignOptimizationTool", 100,
               _TREATMENT_SETTINGS + "DesignOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -167,7 +176,7 @@ _BUILT_IN = (
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              run_options={"print_level": 0}),
+              run_options={"print_level": 0}, validate=_CHECK + "treatment"),
 )
 
 _REGISTRY: dict[str, StageKind] = {kind.tool_element: kind for kind in _BUILT_IN}

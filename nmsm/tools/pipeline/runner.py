@@ -1,6 +1,9 @@
 """Running a pipeline file: ``nmsm pipeline PIPELINE.xml`` / :func:`nmsm.run_pipeline`.
 
-For each enabled stage, in order:
+Before anything runs, every selected stage's settings are validated as its tool will read
+them (:mod:`nmsm.tools.pipeline.validation`: elements, values, term types, solver settings;
+errors at the user's settings file and line), so a typo stops the run before any stage runs
+and before any results are emptied. Then, for each enabled stage, in order:
 
 1. read its settings (file or embedded; old schemas upgraded), rewire its inputs to the
    artifacts available so far (:mod:`nmsm.tools.pipeline.wiring`), point its
@@ -9,13 +12,16 @@ For each enabled stage, in order:
    nmsm's own code);
 3. if ``pipeline_state.json`` records that digest and the recorded outputs are unchanged,
    skip it ("up to date"); otherwise write ``<results>/<stage name>.xml`` (a settings file
-   ``nmsm run`` accepts), empty the stage's folder, run the tool on that file, find its
-   outputs and record the stage.
+   ``nmsm run`` accepts), empty the stage's folder (it gets the runner's marker, see
+   :mod:`nmsm.tools.pipeline.state`), run the tool on that file, find its outputs and record
+   the stage. An error the tool reports at a line of that file is re-pointed at the user's
+   settings file and the element's line there.
 
 Before anything is written or deleted, :class:`~nmsm.errors.InputError` refuses a results
 folder that is (or contains) the pipeline file's folder; an existing, non-empty stage folder
 the runner did not create (not in ``pipeline_state.json``): the runner empties only folders
-it wrote; and a stage folder holding an input of a stage, the pipeline file, a settings file
+it wrote (with ``--rebuild``, also a folder holding the runner's marker: the state file may be
+damaged); and a stage folder holding an input of a stage, the pipeline file, a settings file
 or a starting input, unless it is that stage's own results read by a later stage (like a
 wired output).
 
@@ -41,6 +47,7 @@ from pathlib import Path
 from typing import Any
 
 import attrs
+from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS, Artifacts
@@ -48,7 +55,8 @@ from nmsm.tools.pipeline.hashing import DigestCache, code_digest
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
 from nmsm.tools.pipeline.plan import check_inputs, check_order
 from nmsm.tools.pipeline.stage_settings import StageSettings
-from nmsm.tools.pipeline.state import VERSION, PipelineState, StageRecord
+from nmsm.tools.pipeline.state import MARKER, VERSION, PipelineState, StageRecord, has_marker, write_marker
+from nmsm.tools.pipeline.validation import validate_stage
 from nmsm.tools.pipeline.wiring import wire_stage
 
 PIPELINE_COPY = "pipeline.xml"
@@ -153,8 +161,9 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
 
     ``only``: run just these stages (the others must be up to date when a selected stage
     needs their outputs); ``until``: stop after this stage; ``rebuild``: redo every stage;
-    ``force``: redo these stages; ``check_only``: validate and report which stages would
-    run, without running anything. ``stage_options``: extra keyword arguments per stage
+    ``force``: redo these stages; ``check_only``: validate (every selected stage's settings
+    too) and report which stages would run and how they would be wired, without running or
+    writing anything. ``stage_options``: extra keyword arguments per stage
     name for its tool's ``run_settings``.
     """
     say = log or (lambda text: None)
@@ -166,15 +175,19 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     enabled = [s for s in spec.stages if s.enabled]
     check_inputs(spec, {s.name: s.load_settings() for s in enabled})
     selected = _selection(spec, only, until)
-    state = PipelineState.load(results)
+    checked = validate_stages(spec, selected, quiet=not check_only, every_error=check_only)
+    if check_only:
+        say(f"settings checked: {', '.join(checked) or 'no stage selected'}")
+    state = PipelineState.load(results, salvage=rebuild)
     protected = input_paths(spec, results)
     for stage in enabled:
         if stage.name in selected:
-            _check_stage_folder(spec, stage, results, state, protected)
+            _check_stage_folder(spec, stage, results, state, protected, trust_markers=rebuild)
     forced = set(force) | ({s.name for s in spec.stages} if rebuild else set())
     cache = DigestCache(exclude=[results])
     artifacts = Artifacts()
     unavailable: dict[str, str] = {}  # artifact -> stage that should have made it but did not run
+    pending: set[str] = set()  # check_only: artifacts of stages that would run (wired, not made yet)
     for name, path in spec.inputs.items():
         artifacts.provide(name, path, "the pipeline inputs")
     if not check_only:
@@ -191,8 +204,9 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
         settings, wired = prepare_stage(stage, artifacts, results)
         digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}", code_digest())
         record = state.records.get(stage.name)
+        waits = any(a in pending for a in (*stage.kind.requires, *stage.kind.uses))
         current = (record is not None and record.input_digest == digest and record.kind == stage.kind.code
-                   and stage.name not in forced and _outputs_intact(record, results, cache))
+                   and stage.name not in forced and not waits and _outputs_intact(record, results, cache))
         settings_file = results / f"{stage.name}.xml"
         folder = _stage_folder(results, stage)
         if current:
@@ -211,12 +225,17 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
                                          settings_file, folder, {}, wired))
             say(f"{head}: {status}")
             for artifact in stage.kind.produces:
+                if stage.name in selected:  # --check: wired as in the run, made when the stage runs
+                    artifacts.provide(artifact, _stand_in(results, stage, artifact), f"stage '{stage.name}'")
+                    pending.add(artifact)
+                    continue
                 artifacts.items.pop(artifact, None)
+                pending.discard(artifact)
                 unavailable[artifact] = stage.name
             continue
         _require_available(stage, unavailable)
         say(f"{head}: running")
-        _check_stage_folder(spec, stage, results, state, protected)
+        _check_stage_folder(spec, stage, results, state, protected, trust_markers=rebuild)
         outcome = _run_stage(stage, settings, settings_file, folder, results, digest, state, cache, wired,
                              (stage_options or {}).get(stage.name, {}))
         for artifact, path in outcome.outputs.items():
@@ -228,6 +247,45 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     if not check_only:
         (results / SUMMARY_FILE).write_text(run.summary() + "\n")
     return run
+
+
+def _stand_in(results: Path, stage: StageSpec, artifact: str) -> Path:
+    """Where an artifact of ``stage`` is assumed before the stage made it (never read)."""
+    return _stage_folder(results, stage).resolve() / f".{artifact}"
+
+
+def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = True, every_error: bool = False,
+                    ) -> list[str]:
+    """Validate the settings of every enabled stage in ``selected`` as the runner will hand
+    them to the tool (:mod:`nmsm.tools.pipeline.validation`), earlier stages' outputs wired
+    as stand-ins; :class:`InputError` at the user's settings file and line (``every_error``:
+    one error listing every stage's first error, when several stages have one). Returns the
+    names of the stages checked. Nothing is read from or written into the results tree."""
+    results = spec.results_directory
+    artifacts = Artifacts()
+    for name, path in spec.inputs.items():
+        artifacts.provide(name, path, "the pipeline inputs")
+    checked: list[str] = []
+    errors: list[InputError] = []
+    for stage in spec.stages:
+        if not stage.enabled:
+            continue
+        if stage.name in selected:
+            settings, _ = prepare_stage(stage, artifacts.copy(), results)
+            try:
+                validate_stage(stage, settings, quiet=quiet)
+            except InputError as exc:
+                if not every_error:
+                    raise
+                errors.append(exc)
+            checked.append(stage.name)
+        for artifact in stage.kind.produces:
+            artifacts.provide(artifact, _stand_in(results, stage, artifact), f"stage '{stage.name}'")
+    if len(errors) == 1:
+        raise errors[0]
+    if errors:
+        raise InputError(f"the settings of {len(errors)} stages have errors:\n  " + "\n  ".join(map(str, errors)))
+    return checked
 
 
 def _check_results_location(spec: PipelineSpec) -> None:
@@ -271,22 +329,25 @@ def input_paths(spec: PipelineSpec, results: Path) -> dict[Path, tuple[str, int 
             if value is not None and not any(value.resolve().is_relative_to(p) for p in produced):
                 paths.setdefault(value.resolve(), (f"<{field.spec.element}> of stage '{stage.name}'", index))
         for artifact in stage.kind.produces if stage.enabled else ():
-            stand_in = _stage_folder(results, stage).resolve() / f".{artifact}"
+            stand_in = _stand_in(results, stage, artifact)
             artifacts.provide(artifact, stand_in, f"stage '{stage.name}'")
             produced.append(stand_in)
     return paths
 
 
 def _check_stage_folder(spec: PipelineSpec, stage: StageSpec, results: Path, state: PipelineState,
-                        protected: dict[Path, tuple[str, int | None]]) -> None:
+                        protected: dict[Path, tuple[str, int | None]], *, trust_markers: bool = False) -> None:
     """:class:`InputError` unless the runner may write the stage's settings file and empty its
-    folder: the folder is absent, empty or written by the runner, and holds no input (the
-    stage's own results read by a later stage excepted, as wired outputs are)."""
+    folder: the folder is absent, empty or written by the runner (recorded in the state, or,
+    with ``trust_markers`` (``--rebuild``), holding the runner's marker for this stage), and
+    holds no input (the stage's own results read by a later stage excepted, as wired outputs
+    are)."""
     folder, settings_file = _stage_folder(results, stage), results / f"{stage.name}.xml"
     own, position = folder.resolve(), spec.stages.index(stage)
     exists = folder.exists() or folder.is_symlink()
     is_folder = folder.is_dir() and not folder.is_symlink()
-    owned = exists and is_folder and state.owns(stage.name, _relative(folder, results))
+    owned = exists and is_folder and (state.owns(stage.name, _relative(folder, results))
+                                      or (trust_markers and has_marker(folder, stage.name)))
     for path, (what, reader) in protected.items():
         if path == settings_file.resolve():
             found = f"the runner writes the stage's settings to {settings_file}, which is {what}"
@@ -302,8 +363,11 @@ def _check_stage_folder(spec: PipelineSpec, stage: StageSpec, results: Path, sta
                                    "or the inputs outside the results folder")
     if not exists or owned or (is_folder and not any(folder.iterdir())):
         return
-    raise stage.error(f"its results folder {folder} already exists and was not written by this pipeline (not "
-                      f"recorded in {state.path}); nmsm empties only the stage folders it wrote",
+    how = f"not recorded in {state.path}"
+    if state.damaged is not None:
+        how = f"{state.path} is damaged ({state.damaged}) and the folder holds no {MARKER} marker of the runner"
+    raise stage.error(f"its results folder {folder} already exists and was not written by this pipeline ({how}); "
+                      "nmsm empties only the stage folders it wrote",
                       element="<Stage name>",
                       expected=f"{folder} moved away or deleted by hand, another stage name or another "
                                "<results_directory>")
@@ -325,10 +389,16 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
     if folder.exists():
         shutil.rmtree(folder)  # only a folder the runner wrote, or an empty one (_check_stage_folder)
     folder.mkdir(parents=True)
+    write_marker(folder, stage.name)
     state.claim(stage.name, _relative(folder, results))
-    settings_file.write_text(settings.text(settings_file, results))
+    text = settings.text(settings_file, results)
+    settings_file.write_text(text)
     began = time.perf_counter()
-    result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})
+    try:
+        result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})
+    except InputError as exc:
+        _point_at_user_settings(exc, settings_file, text, settings)
+        raise
     wall = time.perf_counter() - began
     outputs = stage.kind.load_outputs()(settings, folder)
     record = StageRecord(
@@ -346,6 +416,30 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
     state.record(record)
     return StageOutcome(stage.name, stage.kind.code, stage.kind.label, RAN, wall, settings_file, folder, outputs,
                         wired, result)
+
+
+def _point_at_user_settings(exc: InputError, settings_file: Path, text: str, settings: StageSettings) -> None:
+    """Make an error at a line of the settings copy the runner wrote (``settings_file``,
+    ``text``) name the user's file (the stage's settings file, or the pipeline file for
+    embedded settings) and the line the element has there. Elements the runner added
+    (rewired inputs, the results folder) have no such line: the error is left as it is."""
+    if exc.file is None or exc.line is None:
+        return
+    try:
+        if Path(exc.file).resolve() != settings_file.resolve():
+            return
+        written = etree.fromstring(text.encode())
+    except (OSError, etree.XMLSyntaxError):
+        return
+    lines: dict[int, int] = {}
+    for copy, original in zip(written.iter(), settings.root.iter()):
+        if copy.sourceline is not None and original.sourceline is not None:
+            lines.setdefault(copy.sourceline, original.sourceline)
+    line = lines.get(exc.line)
+    if line is None:
+        return
+    exc.file, exc.line = str(settings.origin), line
+    exc.args = (exc._compose(),)
 
 
 def run_pipeline_file(pipeline_file: str | os.PathLike[str], **options: Any) -> PipelineRun:

@@ -15,10 +15,15 @@ Paths in records are relative to the results directory (the tree can be moved). 
 stopped half-way has no record, so the next run redoes it and nothing after it.
 ``stage_folders`` lists the stage folders the runner created (saved before the stage's tool
 runs): the runner empties only those (or a folder of a recorded stage), never a folder it
-did not write. A file without it (older nmsm) reads as none created.
+did not write. A file without it (older nmsm) reads as none created. Each folder it
+creates also holds the runner's marker :data:`MARKER` (``{"format": "nmsm-pipeline-stage",
+"stage": NAME}``), so that ``--rebuild`` knows its folders when this file is damaged.
 
-A file of another format version, or a record missing a field, is an
-:class:`~nmsm.errors.InputError` naming the file, the stage and the missing piece.
+A damaged file (not JSON, another format version, a record missing a field) is an
+:class:`~nmsm.errors.InputError` naming the file, the stage and the missing piece, unless
+it is loaded with ``salvage=True`` (``--rebuild``, which redoes every stage anyway): then
+the records are dropped, the folders it still names are kept (when the JSON is readable),
+and the damaged file is moved to ``pipeline_state.json.damaged`` when the state is saved.
 """
 
 from __future__ import annotations
@@ -34,6 +39,11 @@ import attrs
 from nmsm.errors import InputError
 
 STATE_FILE = "pipeline_state.json"
+#: where a damaged state file is moved when ``--rebuild`` saves a new one
+DAMAGED_SUFFIX = ".damaged"
+#: the runner's marker in every stage folder it creates (hidden: left out of output digests)
+MARKER = ".nmsm-pipeline-stage"
+MARKER_FORMAT = "nmsm-pipeline-stage"
 FORMAT = "nmsm-pipeline-state"
 #: version of the results-tree layout and of this file; bump when either changes
 VERSION = 1
@@ -63,12 +73,32 @@ class StageRecord:
 
 
 def _stale_error(path: Path, message: str, expected: str) -> InputError:
-    return InputError(
-        message + "; delete the results folder or choose another <results_directory> "
-        "(or run 'nmsm pipeline --rebuild' to redo every stage)",
+    error = InputError(
+        message + "; run 'nmsm pipeline --rebuild PIPELINE.xml' to redo every stage (it empties only the stage "
+        f"folders this file still names or that hold the runner's {MARKER} marker; any other stage folder must "
+        "be moved away by hand), or delete the results folder or choose another <results_directory>",
         file=path,
         expected=expected,
     )
+    error.reason = message  # type: ignore[attr-defined]
+    return error
+
+
+def write_marker(folder: Path, name: str) -> None:
+    """Mark ``folder`` as created by the runner for stage ``name``."""
+    (folder / MARKER).write_text(json.dumps({"format": MARKER_FORMAT, "stage": name}) + "\n")
+
+
+def has_marker(folder: Path, name: str) -> bool:
+    """Whether ``folder`` holds the runner's marker for stage ``name`` (a regular file)."""
+    marker = folder / MARKER
+    if marker.is_symlink() or not marker.is_file():
+        return False
+    try:
+        data = json.loads(marker.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("format") == MARKER_FORMAT and data.get("stage") == name
 
 
 class PipelineState:
@@ -81,6 +111,8 @@ class PipelineState:
         self.nmsm_version = nmsm_version
         #: stage name -> folder (relative to the results directory) the runner created for it
         self.folders: dict[str, str] = dict(folders or {})
+        #: why the file was not usable (loaded with ``salvage=True``); ``None``: it was
+        self.damaged: str | None = None
 
     @property
     def path(self) -> Path:
@@ -88,9 +120,23 @@ class PipelineState:
 
     # ---- reading -----------------------------------------------------------------------
     @classmethod
-    def load(cls, results_directory: str | os.PathLike[str]) -> PipelineState:
-        """The records of ``results_directory`` (none when the file does not exist yet)."""
+    def load(cls, results_directory: str | os.PathLike[str], *, salvage: bool = False) -> PipelineState:
+        """The records of ``results_directory`` (none when the file does not exist yet).
+
+        ``salvage``: a damaged file gives a state without records that keeps the folders
+        the file still names (module docstring) instead of an error."""
         results_directory = Path(results_directory)
+        try:
+            return cls._load(results_directory)
+        except InputError as exc:
+            if not salvage:
+                raise
+            state = cls(results_directory, folders=_salvage_folders(results_directory / STATE_FILE))
+            state.damaged = getattr(exc, "reason", exc.detail)
+            return state
+
+    @classmethod
+    def _load(cls, results_directory: Path) -> PipelineState:
         path = results_directory / STATE_FILE
         if not path.is_file():
             return cls(results_directory)
@@ -150,6 +196,9 @@ class PipelineState:
         from nmsm import __version__
 
         self.results_directory.mkdir(parents=True, exist_ok=True)
+        if self.damaged is not None and self.path.is_file():
+            os.replace(self.path, self.path.with_name(STATE_FILE + DAMAGED_SUFFIX))  # kept for inspection
+        self.damaged = None
         data = {
             "format": FORMAT,
             "version": VERSION,
@@ -166,3 +215,25 @@ class PipelineState:
         except BaseException:
             Path(temporary).unlink(missing_ok=True)
             raise
+
+
+def _salvage_folders(path: Path) -> dict[str, str]:
+    """Stage name -> folder that a damaged but readable state file still names: its
+    ``stage_folders`` and its records' ``results_directory`` (empty when it is not JSON of
+    this format)."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        return {}
+    folders: dict[str, str] = {}
+    stages = data.get("stages")
+    for name, raw in (stages.items() if isinstance(stages, dict) else ()):
+        if isinstance(raw, dict) and isinstance(raw.get("results_directory"), str):
+            folders[str(name)] = raw["results_directory"]
+    listed = data.get("stage_folders")
+    for name, folder in (listed.items() if isinstance(listed, dict) else ()):
+        if isinstance(folder, str):
+            folders[str(name)] = folder
+    return folders

@@ -34,6 +34,7 @@ class FitterSettings:
     input_model_file: Path = setting("input_model_file", kind="path", path_kind="file", required=True, doc="in")
     data_directory: Path = setting("data_directory", kind="path", path_kind="dir", empty_is_base=True,
                                    default=None, doc="data")
+    degree: int = setting("degree", kind="integer", default=1, doc="an integer the fitter does not use")
 
 
 def _tool(settings_file: Path) -> tuple[Path, dict[str, str]]:
@@ -47,8 +48,18 @@ def _tool(settings_file: Path) -> tuple[Path, dict[str, str]]:
 
 
 def run_maker(settings_file: Path, **options: object) -> str:
+    """Writes the model with the offset; an ``<output_model_file>`` ending in ``.bad`` is
+    refused as a tool refuses bad input: an InputError at that element's line of the file it read."""
     CALLS.append(("maker", Path(settings_file)))
     folder, values = _tool(settings_file)
+    if values["output_model_file"].endswith(".bad"):
+        from lxml import etree
+
+        from nmsm.errors import InputError
+
+        element = etree.parse(str(settings_file)).getroot().find("FakeMakerTool/output_model_file")
+        raise InputError("the maker cannot write .bad files", file=settings_file, line=element.sourceline,
+                         element="<output_model_file>", expected="a .osim name")
     results = folder / values["results_directory"]
     model = Path(values["input_model_file"])
     model = model if model.is_absolute() else folder / model

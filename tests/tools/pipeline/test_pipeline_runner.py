@@ -15,7 +15,7 @@ from fake_stages import CALLS, STOP_NEXT, fake_kinds  # noqa: E402
 
 from nmsm.errors import InputError  # noqa: E402
 from nmsm.tools.pipeline.runner import RAN, UP_TO_DATE, run_pipeline_file  # noqa: E402
-from nmsm.tools.pipeline.state import STATE_FILE  # noqa: E402
+from nmsm.tools.pipeline.state import MARKER, STATE_FILE  # noqa: E402
 
 MAKER_SETTINGS = """<NMSMPipelineDocument Version="1.5.3"><FakeMakerTool>
   <results_directory>ignored_out</results_directory>
@@ -258,3 +258,114 @@ def test_results_directory_of_the_pipeline_folder_is_refused(case: Path) -> None
                                          r"file's own folder.*\(expected a folder of its own"):
         run_pipeline_file(pipeline, log=None)
     assert sorted(p.name for p in case.iterdir()) == before and pipeline.read_text() == text
+
+
+# ---- settings validated before anything runs or is emptied -----------------------------------------
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_settings_error_names_the_users_file_and_keeps_finished_results(case: Path) -> None:
+    """A typo in a finished stage's settings: the error is at the user's file and line, and the
+    stage's earlier results (and every other file of the tree) are left as they were."""
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    before = _tree(case / "results")
+    CALLS.clear()
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(_pipeline(case, offset="1.5x"), log=None)
+    assert str(info.value).startswith(f"{case / 'maker.xml'}:5: <offset>: '1.5x' is not a number")
+    assert CALLS == [] and _tree(case / "results") == before
+    # embedded settings: the pipeline file and its line
+    pipeline = _pipeline(case)
+    text = pipeline.read_text().replace("<results_directory/>", "<results_directory/><degree>2.5</degree>")
+    pipeline.write_text(text)
+    with pytest.raises(InputError, match=f"^{pipeline}:3: <degree>: '2.5' is not an integer"):
+        run_pipeline_file(pipeline, log=None)
+    assert CALLS == [] and _tree(case / "results") == before
+
+
+def test_tool_error_in_the_written_settings_points_at_the_users_file(case: Path) -> None:
+    """An error the tool finds while running, at a line of the copy the runner wrote into the
+    results tree (<stage>.xml), names the user's settings file and the element's line there."""
+    _pipeline(case)
+    settings = case / "maker.xml"
+    settings.write_text(settings.read_text().replace("made.osim", "made.bad"))
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(case / "pipeline.xml", log=None)
+    assert str(info.value) == (f"{settings}:4: <output_model_file>: the maker cannot write .bad files "
+                               "(expected a .osim name)")
+
+
+def test_check_validates_settings_and_shows_the_run_s_wiring(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run = run_pipeline_file(pipeline, check_only=True, log=None)
+    assert _statuses(run) == {"make": "would run", "fit": "would run"}
+    assert not (case / "results").exists()
+    # the same wiring lines as the real run
+    real = run_pipeline_file(pipeline, log=None)
+    assert run.stage("fit").wired == real.stage("fit").wired
+    assert "input_model_file <- model from stage 'make'" in run.summary()
+    # an edited maker: both would run again, still wired from the maker
+    run = run_pipeline_file(_pipeline(case, offset="3"), check_only=True, log=None)
+    assert _statuses(run) == {"make": "would run", "fit": "would run"}
+    assert run.stage("fit").wired == real.stage("fit").wired
+    before = _tree(case / "results")
+    with pytest.raises(InputError, match=r"maker.xml:5: <offset>: 'x' is not a number"):
+        run_pipeline_file(_pipeline(case, offset="x"), check_only=True, log=None)
+    # --check reports every stage's error; a run stops at the first
+    pipeline = _pipeline(case, offset="x")
+    pipeline.write_text(pipeline.read_text().replace("<results_directory/>", "<results_directory/><degree>a</degree>"))
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(pipeline, check_only=True, log=None)
+    assert str(info.value).splitlines() == [
+        "the settings of 2 stages have errors:",
+        f"  {case / 'maker.xml'}:5: <offset>: 'x' is not a number (expected a number)",
+        f"  {pipeline}:3: <degree>: 'a' is not an integer (expected an integer)"]
+    with pytest.raises(InputError, match="maker.xml:5: <offset>"):
+        run_pipeline_file(pipeline, log=None)
+    assert _tree(case / "results") == before
+
+
+# ---- a damaged pipeline_state.json and --rebuild -----------------------------------------------------
+def test_rebuild_works_on_a_damaged_state(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    state_file = case / "results" / STATE_FILE
+    good = state_file.read_text()
+    for damage in ("truncated", "missing field"):
+        if damage == "truncated":
+            state_file.write_text(good[:300])
+        else:
+            data = json.loads(good)
+            del data["stages"]["make"]["outputs"]
+            state_file.write_text(json.dumps(data))
+        damaged = state_file.read_text()
+        with pytest.raises(InputError, match=r"pipeline_state.json: .*run 'nmsm pipeline --rebuild PIPELINE.xml' "
+                                             r"to redo every stage"):
+            run_pipeline_file(pipeline, log=None)
+        run = run_pipeline_file(pipeline, rebuild=True, check_only=True, log=None)
+        assert _statuses(run) == {"make": "would run", "fit": "would run"} and state_file.read_text() == damaged
+        run = run_pipeline_file(pipeline, rebuild=True, log=None)
+        assert _statuses(run) == {"make": RAN, "fit": RAN}
+        assert (case / "results" / (STATE_FILE + ".damaged")).read_text() == damaged  # kept for inspection
+        assert set(json.loads(state_file.read_text())["stages"]) == {"make", "fit"}
+        assert _statuses(run_pipeline_file(pipeline, log=None)) == {"make": UP_TO_DATE, "fit": UP_TO_DATE}
+
+
+def test_rebuild_on_an_unreadable_state_never_empties_an_unmarked_folder(case: Path) -> None:
+    """With pipeline_state.json unreadable, only folders holding the runner's marker are the
+    runner's: a stage folder without it (a tree of an older nmsm, files put there by hand) is kept."""
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    results = case / "results"
+    (results / "fit" / MARKER).unlink()
+    (results / STATE_FILE).write_text('{"format": "nmsm-pipeline-state", "vers')
+    before = _tree(results)
+    CALLS.clear()
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(pipeline, rebuild=True, log=None)
+    text = str(info.value)
+    assert f"its results folder {results / 'fit'} already exists and was not written by this pipeline" in text
+    assert "is damaged (unreadable pipeline state" in text and f"holds no {MARKER} marker" in text
+    assert _tree(results) == before and CALLS == []

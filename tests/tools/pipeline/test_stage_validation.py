@@ -1,0 +1,107 @@
+"""A TO -> VO -> DO pipeline on the torque kicking tutorial: stage settings are validated
+(terms included) before anything runs or is emptied, errors name the user's settings file,
+and ``--check`` validates and shows the run's wiring."""
+
+from __future__ import annotations
+
+import shutil
+import warnings
+from pathlib import Path
+
+import pytest
+
+from nmsm.cli import main
+from nmsm.errors import InputError
+from nmsm.tools.pipeline.runner import RAN, run_pipeline_file
+
+TUTORIAL = "treatment/torque_kick_tutorial"
+PIPELINE = """<NMSMPipelineDocument Version="1.5.3">
+  <PipelineTool name="kick">
+    <results_directory>results</results_directory>
+    <input_model_file>KickingModel.osim</input_model_file>
+    <data_directory>preprocessed</data_directory>
+    <StageList>
+      <Stage name="to"><settings_file>TO.xml</settings_file></Stage>
+      <Stage name="vo"><settings_file>VO.xml</settings_file></Stage>
+      <Stage name="do"><settings_file>DO.xml</settings_file></Stage>
+    </StageList>
+  </PipelineTool>
+</NMSMPipelineDocument>
+"""
+TYPO = ("<type>controller_tracking</type>", "<type>controler_tracking</type>")
+
+
+@pytest.fixture()
+def kick(shared_data: Path, tmp_path: Path) -> Path:
+    source = shared_data / TUTORIAL
+    folder = tmp_path / "kick"
+    folder.mkdir()
+    shutil.copy(source / "KickingModel.osim", folder)
+    shutil.copy(source / "GpopsSettings.xml", folder)
+    shutil.copytree(source / "preprocessed", folder / "preprocessed")
+    for code in ("TO", "VO", "DO"):
+        text = (source / "CompletedSettingsFiles" / f"Torque{code}SettingsV1.xml").read_text()
+        (folder / f"{code}.xml").write_text(text.replace(">gpopsSettings.xml<", ">GpopsSettings.xml<"))
+    (folder / "pipeline.xml").write_text(PIPELINE)
+    for path in [folder, *folder.rglob("*")]:
+        path.chmod(path.stat().st_mode | 0o200)
+    return folder
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _wiring(summary: str, stage: str) -> list[str]:
+    """The ``element <- source`` lines a summary shows under ``stage``."""
+    lines = summary.splitlines()
+    start = next(k for k, line in enumerate(lines) if line.split()[:1] == [stage] and line.startswith("  "))
+    block = []
+    for line in lines[start + 1:]:
+        if not line.startswith("      "):
+            break
+        block.append(line.strip())
+    return block
+
+
+def _type_line(settings: Path) -> int:
+    """The line of the <RCNLCostTerm> holding the misspelled type (the term registry names the term)."""
+    lines = settings.read_text().splitlines()
+    typo = next(k for k, line in enumerate(lines) if TYPO[1] in line)
+    return next(k for k in range(typo, -1, -1) if "<RCNLCostTerm" in lines[k]) + 1
+
+
+def test_stage_settings_are_checked_before_anything_runs_or_is_emptied(
+    kick: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pipeline, do = kick / "pipeline.xml", kick / "DO.xml"
+    # --check: the settings are validated, and the wiring shown is the run's
+    assert main(["pipeline", "--check", str(pipeline)]) == 0
+    out = capsys.readouterr().out
+    assert "settings checked: to, vo, do" in out
+    for stage, source in (("vo", "to"), ("do", "vo")):
+        wiring = _wiring(out, stage)
+        assert f"initial_guess_directory <- treatment_results from stage '{source}'" in wiring
+        assert f"tracked_quantities_directory <- treatment_results from stage '{source}'" in wiring
+    assert not (kick / "results").exists()
+    # a misspelled term type: --check names DO.xml and the term's line
+    good = do.read_text()
+    do.write_text(good.replace(*TYPO))
+    assert main(["pipeline", "--check", str(pipeline)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"nmsm: error: {do}:{_type_line(do)}: <type>: unknown cost 'controler_tracking' for DO")
+    assert "Traceback" not in err and not (kick / "results").exists()
+    # the finished DO results survive the same typo in a real run
+    do.write_text(good)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_pipeline_file(pipeline, log=None)
+    assert {s.name: s.status for s in run.stages} == {"to": RAN, "vo": RAN, "do": RAN}
+    before = _tree(kick / "results")
+    assert any(name.startswith("do/") and name.endswith("_states.sto") for name in before)
+    do.write_text(good.replace(*TYPO))
+    with pytest.raises(InputError) as info:
+        run_pipeline_file(pipeline, log=None)
+    assert str(info.value).startswith(f"{do}:{_type_line(do)}: <type>: unknown cost 'controler_tracking'")
+    assert "results/do.xml" not in str(info.value)
+    assert _tree(kick / "results") == before
