@@ -56,7 +56,8 @@ class TorqueController(Controller):
                 raise setup.error(
                     f"torque-controlled coordinate '{c}' has no column in the tracked inverse dynamics "
                     "(IDData), needed for its control bounds", element=element,
-                    expected=f"a column '{self._load_labels[c]}' in the tracked IDData file")
+                    expected=f"a column '{self._load_labels[c]}' in the tracked IDData file"
+                             + (f" {loads.source}" if loads is not None and getattr(loads, "source", None) else ""))
             lo, hi = range_bounds(loads.values(loads.time, 0, [label]), rule)
             self._bounds[c] = (float(lo[0]), float(hi[0]))
         self._reference = {}

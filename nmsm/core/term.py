@@ -60,6 +60,19 @@ class TermSpec:
     field_lines: Mapping[str, int] = attrs.field(factory=dict)
 
 
+class TermValueError(ValueError):
+    """A term field's value is out of its range (raised by field validators).
+
+    ``field`` is the field (settings element) at fault and ``expected`` what it accepts, so
+    :meth:`Term.from_spec` can name the element, its line and the accepted values.
+    """
+
+    def __init__(self, message: str, *, field: str, expected: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+        self.expected = expected
+
+
 class TermContext(Protocol):
     """What a tool hands to its terms. Tools add their own quantities (model outputs)."""
 
@@ -144,13 +157,32 @@ class Term:
     is_enabled: bool = True
     name: str | None = None
     source: SourceRef = attrs.field(factory=SourceRef, eq=False, repr=False)
+    #: the term's settings elements as written in its file -> line (messages name what the file says)
+    element_lines: Mapping[str, int | None] = attrs.field(factory=dict, eq=False, repr=False)
 
     # ----- construction from settings -------------------------------------------------
     @classmethod
     def xml_fields(cls) -> dict[str, Any]:
         """Settings element name -> annotated type, for every settable field."""
         hints = typing.get_type_hints(cls)
-        return {f.name: hints[f.name] for f in attrs.fields(cls) if f.name not in ("source",)}
+        return {f.name: hints[f.name] for f in attrs.fields(cls) if f.name not in _NOT_XML}
+
+    @classmethod
+    def element_spellings(cls, name: str) -> tuple[str, ...]:
+        """Every settings element that sets field ``name`` (or its ``*_list`` form): the field,
+        its list form (one term per item) and its aliases, e.g. ``coordinate``, ``coordinate_list``."""
+        singular = LIST_TO_SINGULAR.get(name, name)
+        out = [singular] + [plural for plural, single in LIST_TO_SINGULAR.items() if single == singular]
+        out += [alias for alias, target in cls.aliases.items() if target in (name, singular)]
+        if name not in out:
+            out.insert(0, name)
+        return tuple(out)
+
+    @classmethod
+    def _missing_required(cls, given: set[str]) -> list[str]:
+        """Required fields (no default) that none of ``given`` (field names) sets."""
+        return [f.name for f in attrs.fields(cls)
+                if f.default is attrs.NOTHING and f.init and f.name not in _NOT_XML and f.name not in given]
 
     @classmethod
     def from_spec(cls, spec: TermSpec) -> list[Term]:
@@ -183,11 +215,13 @@ class Term:
                 )
             raw[target] = text
         values: dict[str, Any] = {}
+        attributes = attrs.fields_dict(cls)
         for key, text in raw.items():
             if text.strip() == "" and key in ("max_allowable_error", "error_center", "max_error", "min_error"):
+                default = attributes[key].default
                 warnings.warn(
                     f"{spec.source.file}:{spec.field_lines.get(key, spec.source.line)}: empty <{key}> in "
-                    f"term '{cls.type}' treated as absent (default used)",
+                    f"term '{cls.type}' treated as absent (default {_number(default)} used)",
                     stacklevel=2,
                 )
                 continue
@@ -200,21 +234,31 @@ class Term:
                     line=spec.field_lines.get(key, spec.source.line),
                     expected=f"{getattr(fields[key], '__name__', fields[key])}",
                 ) from exc
+        term_element = f"<{'RCNLCostTerm' if spec.kind == 'cost' else 'RCNLConstraintTerm'}>"
+        missing = cls._missing_required(set(values) | set(splits))
+        if missing:
+            raise InputError(
+                f"term '{cls.type}' has no " + " and no ".join(f"<{name}>" for name in missing),
+                file=spec.source.file,
+                line=spec.source.line,
+                element=term_element,
+                expected="; ".join(" or ".join(f"<{e}>" for e in cls.element_spellings(name)) for name in missing),
+            )
+        element_lines = {element: spec.field_lines.get(element) for element in spec.fields}
         keys = list(splits)
         out: list[Term] = []
         for combination in itertools.product(*(splits[k] for k in keys)):
             kw = dict(values)
             kw.update(zip(keys, combination))
             try:
-                out.append(cls(source=spec.source, **kw))
+                out.append(cls(source=spec.source, element_lines=element_lines, **kw))
+            except TermValueError as exc:
+                element, line = _as_written(cls, element_lines, exc.field, spec.source.line)
+                raise InputError(f"term '{cls.type}': {exc}", file=spec.source.file, line=line, element=element,
+                                 expected=exc.expected) from exc
             except (TypeError, ValueError) as exc:
-                raise InputError(
-                    f"term '{cls.type}': {exc}",
-                    file=spec.source.file,
-                    line=spec.source.line,
-                    expected="the term's required elements: "
-                    + ", ".join(f.name for f in attrs.fields(cls) if f.default is attrs.NOTHING),
-                ) from exc
+                raise InputError(f"term '{cls.type}': {exc}", file=spec.source.file, line=spec.source.line,
+                                 element=term_element) from exc
         return out
 
     # ----- binding and errors ------------------------------------------------------------
@@ -222,12 +266,19 @@ class Term:
         """Check names against the model and data once, before any solve. Override."""
 
     def error(self, message: str, *, element: str | None = None, expected: str | None = None) -> InputError:
-        """An :class:`InputError` pointing at this term's declaration."""
+        """An :class:`InputError` pointing at this term's declaration.
+
+        ``element`` (e.g. ``"<coordinate_list>"``) is named as the settings file spells it
+        (``<coordinate>`` when the term gives a single ``<coordinate>``), at its line.
+        """
         label = f"term '{self.type}'" + (f" ({self.name})" if self.name else "")
+        line = self.source.line
+        if element and element.count("<") == 1 and element.startswith("<") and element.endswith(">"):
+            element, line = _as_written(type(self), self.element_lines, element[1:-1], line)
         return InputError(
             f"{label}: {message}",
             file=self.source.file,
-            line=self.source.line,
+            line=line,
             element=element,
             expected=expected,
         )
@@ -244,9 +295,28 @@ class Term:
         return ":".join(parts)
 
 
+def _number(value: Any) -> str:
+    return f"{value:g}" if isinstance(value, (int, float)) else repr(value)
+
+
+#: Term fields that are not settings elements
+_NOT_XML = ("source", "element_lines")
+
+
+def _as_written(cls: type[Term], element_lines: Mapping[str, int | None], name: str,
+                line: int | None) -> tuple[str, int | None]:
+    """``<name>`` as the term's settings spell it (``<coordinate>`` for ``coordinate_list``,
+    ``<max_value>`` for ``max_error``, ...) and its line; ``<name>`` at ``line`` if not written."""
+    for spelling in cls.element_spellings(name):
+        if spelling in element_lines:
+            return f"<{spelling}>", element_lines[spelling] or line
+    return f"<{name}>", line
+
+
 def _positive(instance: Any, attribute: attrs.Attribute, value: float) -> None:
     if not value > 0:
-        raise ValueError(f"'{attribute.name}' must be > 0 (got {value})")
+        raise TermValueError(f"'{attribute.name}' must be > 0 (got {value})", field=attribute.name,
+                             expected="a number > 0")
 
 
 @attrs.frozen(kw_only=True)
@@ -283,7 +353,8 @@ class ConstraintTerm(Term):
 
     def __attrs_post_init__(self) -> None:
         if self.min_error > self.max_error:
-            raise ValueError(f"min_error {self.min_error} > max_error {self.max_error}")
+            raise TermValueError(f"min_error {self.min_error} > max_error {self.max_error}", field="min_error",
+                                 expected="<min_error> <= <max_error>")
 
     def value(self, ctx: Any) -> Any:
         """The constrained quantity (CasADi expression). Override."""

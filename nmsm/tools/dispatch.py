@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +35,9 @@ def tool_element_name(settings_file: str | Path) -> str:
     if native is not None:
         return native
 
-    doc = read_settings_document(settings_file)
+    with warnings.catch_warnings():  # the tool's own reading reports the upgrade, once
+        warnings.simplefilter("ignore")
+        doc = read_settings_document(settings_file)
     return doc.tool_element.tag
 
 

@@ -9,6 +9,7 @@ element, else from the tool element.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar
@@ -16,7 +17,7 @@ from typing import Any, ClassVar
 import attrs
 
 from nmsm.core.term import SourceRef, TermSpec
-from nmsm.io.settings.document import SettingsDocument
+from nmsm.io.settings.document import SettingsDocument, elements
 from nmsm.io.settings.schema import (
     ReadContext,
     at_least_one,
@@ -48,6 +49,24 @@ _CONSTRAINT_EXAMPLE = (
         "min_error": "-0.1",
     },
 )
+
+
+#: controller elements of the tool element
+CONTROLLER_ELEMENTS = ("RCNLSynergyController", "RCNLTorqueController", "RCNLMuscleController")
+
+
+def _controller_near_misses(ctx: ReadContext) -> str:
+    """`` (found <X> at line N: did you mean <Y>?)`` for children of the tool element that
+    look like a misspelled controller element; empty when there is none."""
+    found = []
+    for child in elements(ctx.element):
+        tag = str(child.tag)
+        close = difflib.get_close_matches(tag, CONTROLLER_ELEMENTS, n=1, cutoff=0.75)
+        if close:
+            found.append(f"found <{tag}> at line {child.sourceline}: did you mean <{close[0]}>?")
+        elif "controller" in tag.lower():
+            found.append(f"found <{tag}> at line {child.sourceline}, not a controller element")
+    return f" ({'; '.join(found)})" if found else ""
 
 
 @attrs.frozen(kw_only=True)
@@ -415,7 +434,7 @@ class TreatmentOptimizationSettings:
                 and values.get("muscle_controller") is None):
             raise ctx.doc.error(
                 ctx.element,
-                "no controller",
+                "no controller" + _controller_near_misses(ctx),
                 element="<RCNLSynergyController>/<RCNLTorqueController>",
                 expected="an <RCNLSynergyController> and/or an <RCNLTorqueController>",
             )
@@ -470,7 +489,7 @@ class DesignOptimizationSettings(TreatmentOptimizationSettings):
         default=None,
         check=increasing_pair,
         example="0.9 1.3",
-        doc="Free final time between these bounds (s); fixed final time if absent",
+        doc="Free final time between these bounds (s, 0 < lower < upper); fixed final time if absent",
     )
     model_functions: tuple[str, ...] = setting(
         "model_functions", kind="names", default=(), doc="Functions applied to the model at each evaluation"
@@ -483,3 +502,14 @@ class DesignOptimizationSettings(TreatmentOptimizationSettings):
         default=(),
         doc="Static design parameters",
     )
+
+    @classmethod
+    def validate(cls, values: dict[str, Any], ctx: ReadContext) -> None:
+        super().validate(values, ctx)
+        bounds = values.get("final_time_range")
+        if bounds is not None and not 0 < bounds[0] <= bounds[1]:
+            raise ctx.error(
+                "final_time_range",
+                f"final time bounds {bounds[0]:g} {bounds[1]:g}: a final time (the movement's duration) must be > 0",
+                "0 < lower <= upper (s)",
+            )

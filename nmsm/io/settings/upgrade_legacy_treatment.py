@@ -8,6 +8,8 @@ Each rule is listed in ``docs/settings-upgrade.md``.
 
 from __future__ import annotations
 
+import difflib
+
 from lxml import etree
 
 from nmsm.errors import InputError
@@ -15,6 +17,8 @@ from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import elements
 from nmsm.io.settings.upgrade import Upgrader, child_of
 
+#: 0.1.0 ``<type_of_controller>`` values (the original accepts only these two controllers)
+CONTROLLER_TYPES = ("torque_driven", "synergy_driven")
 #: 0.1.0 tracking cost types -> current
 TRACKING_TYPES = {
     "coordinate": "generalized_coordinate_tracking",
@@ -121,6 +125,7 @@ def _controller(up: Upgrader, tool: etree._Element) -> etree._Element | None:
     optimize = child_of(tool, "optimize_synergy_vectors")
     if kind is None:
         return None
+    _check_controller_type(up, kind)
     for element in (kind, coordinates, optimize):
         if element is not None:
             up.remove_description(element)
@@ -146,10 +151,27 @@ def _controller(up: Upgrader, tool: etree._Element) -> etree._Element | None:
                 up.drop(optimize, "synergy vectors cannot be optimized with a torque controller")
             else:
                 tool.remove(optimize)
-        up.note(kind, f"{_text(kind) or 'torque_driven'} -> <RCNLTorqueController> with the old <coordinate_list>")
+        up.note(kind, "torque_driven -> <RCNLTorqueController> with the old <coordinate_list>")
     tool.insert(position, controller)
     tool.remove(kind)
     return controller
+
+
+def _check_controller_type(up: Upgrader, kind: etree._Element) -> None:
+    """An :class:`InputError` unless ``<type_of_controller>`` is one of :data:`CONTROLLER_TYPES`."""
+    value = _text(kind)
+    if value in CONTROLLER_TYPES:
+        return
+    close = difflib.get_close_matches(value, CONTROLLER_TYPES, n=1, cutoff=0.8)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    problem = f"'{value}' is not a controller type" if value else "empty controller type"
+    raise InputError(
+        f"{problem} of the 0.1.0 schema{hint}",
+        file=up.path,
+        line=kind.sourceline,
+        element="<type_of_controller>",
+        expected=" or ".join(CONTROLLER_TYPES),
+    )
 
 
 def _bounds(up: Upgrader, tool: etree._Element, controller: etree._Element | None) -> None:

@@ -6,8 +6,10 @@ and the files a previous TO/VO/DO wrote: ``<trial>_states.sto`` (``q``, ``q_u`` 
 ``<trial>_accelerations.sto``, ``<trial>_torqueControls.sto``, ``<trial>_synergyCommands.sto``,
 ``<trial>_combinedActivations.sto`` and ``synergyWeights.sto``. Tracked data come from the
 tracked folder, the initial kinematics from the initial-guess folder (falling back to the
-tracked ones). Times are shifted to start at 0; IK degrees become radians for the model's
-rotational coordinates only.
+tracked ones). Times are shifted to start at 0 (each file's start is kept in
+``TreatmentFiles.start_times``); IK degrees become radians for the model's rotational
+coordinates only. :func:`guess_time_problems` reports initial-guess files on other times than
+the tracked data.
 """
 
 from __future__ import annotations
@@ -47,20 +49,30 @@ class TreatmentFiles:
     synergy_weights: Table | None
     tracked_directory: Path
     initial_directory: Path
+    #: first time (s) of each file as written, by file path (tables are shifted to start at 0)
+    start_times: dict[str, float] = attrs.field(factory=dict)
+
+    def time_range(self, table: Table) -> tuple[float, float]:
+        """``(start, end)`` of ``table`` in its file's time (s), before the shift to 0."""
+        start = self.start_times.get(str(table.source), 0.0)
+        return start, start + duration(table)
 
 
-def _shift(table: Table) -> Table:
+def _shift(table: Table, starts: dict[str, float] | None = None) -> Table:
+    if starts is not None and table.source is not None:
+        starts[str(table.source)] = float(table.time[0])
     return attrs.evolve(table, time=table.time - table.time[0])
 
 
-def _optional_trial_table(folder: Path, trial: str, **kwargs) -> Table | None:
+def _optional_trial_table(folder: Path, trial: str, starts: dict[str, float] | None = None,
+                          **kwargs) -> Table | None:
     if not folder.is_dir():
         return None
     try:
         path = find_trial_file(folder, trial)
     except InputError:
         return None
-    return _shift(read_storage(path, **kwargs))
+    return _shift(read_storage(path, **kwargs), starts)
 
 
 def _kinematics(table: Table, model: TreatmentModel) -> Table:
@@ -91,13 +103,14 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
     if not ik_folder.is_dir():
         raise InputError(f"no IKData folder in the tracked quantities directory {tracked_dir}", file=settings_file,
                          element="<tracked_quantities_directory>", expected="a folder holding IKData/<trial>.sto")
-    tracked_ik = _kinematics(_shift(read_storage(find_trial_file(ik_folder, trial))), model)
-    tracked_id = _optional_trial_table(tracked_dir / "IDData", trial)
-    tracked_grf = _optional_trial_table(tracked_dir / "GRFData", trial,
+    starts: dict[str, float] = {}
+    tracked_ik = _kinematics(_shift(read_storage(find_trial_file(ik_folder, trial)), starts), model)
+    tracked_id = _optional_trial_table(tracked_dir / "IDData", trial, starts)
+    tracked_grf = _optional_trial_table(tracked_dir / "GRFData", trial, starts,
                                         allow_nan=lambda label: label.endswith(COP_SUFFIXES))
-    initial_ik = _optional_trial_table(initial_dir / "IKData", trial)
+    initial_ik = _optional_trial_table(initial_dir / "IKData", trial, starts)
     initial_ik = _kinematics(initial_ik, model) if initial_ik is not None else tracked_ik
-    initial_id = _optional_trial_table(initial_dir / "IDData", trial)
+    initial_id = _optional_trial_table(initial_dir / "IDData", trial, starts)
     if initial_id is None:
         initial_id = tracked_id
     results: dict[str, Table] = {}
@@ -105,7 +118,7 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
         for kind, suffix in RESULT_FILES.items():
             path = _result_file(initial_dir, trial, suffix)
             if path is not None:
-                table = _shift(read_storage(path))
+                table = _shift(read_storage(path), starts)
                 if kind in ("states", "accelerations") and table.in_degrees:
                     table = _kinematics(table, model)
                 results[kind] = table
@@ -118,8 +131,61 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
         warnings.warn(f"{tracked_dir}: no IDData/{trial}: terms and torque controls needing tracked loads will fail",
                       stacklevel=2)
     return TreatmentFiles(trial, tracked_ik, tracked_id, tracked_grf, initial_ik, initial_id, results, synergy_weights,
-                          tracked_dir, initial_dir)
+                          tracked_dir, initial_dir, starts)
 
 
 def duration(table: Table) -> float:
     return float(np.asarray(table.time)[-1] - np.asarray(table.time)[0])
+
+
+def _sample_interval(table: Table) -> float:
+    """Largest time step of ``table`` (s)."""
+    return float(np.max(np.diff(np.asarray(table.time)))) if table.n_rows > 1 else 0.0
+
+
+def guess_tables(files: TreatmentFiles) -> list[Table]:
+    """The initial-guess tables of ``files`` (its initial-guess folder's files, not the tracked ones)."""
+    tables = list(files.results.values())
+    if files.initial_id is not None and files.initial_id is not files.tracked_id:
+        tables.insert(0, files.initial_id)
+    if files.initial_ik is not files.tracked_ik:
+        tables.insert(0, files.initial_ik)
+    return tables
+
+
+def guess_time_problems(files: TreatmentFiles, read_duration: float) -> list[str]:
+    """Initial-guess files that do not span the time they are read on (one line per time range).
+
+    The guess is read from its own start for ``read_duration`` seconds (the tracked data's
+    duration with a fixed final time; the guess's with a free one), on the same normalized
+    time as the tracked data. A file matches when its duration is ``read_duration`` and it
+    starts where the tracked data start (or at 0: nmsm writes results from 0), each within
+    one sample interval (the larger of the file's and the tracked data's).
+    """
+    tracked_start = files.time_range(files.tracked_ik)[0]
+    wrong: dict[tuple[float, float], list[Table]] = {}
+    tolerance = 0.0
+    for table in guess_tables(files):
+        start, end = files.time_range(table)
+        allowed = max(_sample_interval(table), _sample_interval(files.tracked_ik)) + 1e-9
+        if abs(end - start - read_duration) <= allowed and min(abs(start - tracked_start), abs(start)) <= allowed:
+            continue
+        tolerance = max(tolerance, allowed)
+        wrong.setdefault((start, end), []).append(table)
+    out = []
+    for (start, end), tables in wrong.items():
+        names = ", ".join(_relative(t.source, files.initial_directory) for t in tables)
+        out.append(f"initial guess {names} in {files.initial_directory} spans {start:.6g}-{end:.6g} s "
+                   f"({end - start:.6g} s); expected {tracked_start:.6g}-{tracked_start + read_duration:.6g} s "
+                   f"({read_duration:.6g} s, the time range of the tracked data {files.tracked_ik.source}) within "
+                   f"one sample interval ({tolerance:.2g} s)")
+    return out
+
+
+def _relative(path: Path | None, folder: Path) -> str:
+    if path is None:
+        return "(a table without file)"
+    try:
+        return Path(path).relative_to(folder).as_posix()
+    except ValueError:
+        return str(path)

@@ -42,19 +42,22 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.core.term import ConstraintTerm, CostTerm
+from nmsm.core.term import ConstraintTerm, CostTerm, TermValueError
 
 TREATMENT_TOOLS = frozenset({"TO", "VO", "DO"})
 
 
 def _ranges(instance: Any, attribute: attrs.Attribute, value: tuple[float, ...] | None) -> None:
+    expected = "pairs 'start end' of normalized time with 0 <= start < end <= 1"
     if value is None:
         return
     if len(value) % 2 or not value:
-        raise ValueError(f"'{attribute.name}' needs pairs 'start end' in normalized time [0, 1], got {value}")
+        raise TermValueError(f"'{attribute.name}' needs pairs 'start end' in normalized time [0, 1], got {value}",
+                             field=attribute.name, expected=expected)
     for a, b in zip(value[::2], value[1::2]):
         if not (0.0 <= a < b <= 1.0):
-            raise ValueError(f"'{attribute.name}': each range must satisfy 0 <= start < end <= 1, got {a} {b}")
+            raise TermValueError(f"'{attribute.name}': each range must satisfy 0 <= start < end <= 1, got {a} {b}",
+                                 field=attribute.name, expected=expected)
 
 
 @attrs.frozen(kw_only=True)

@@ -23,11 +23,12 @@ from nmsm.errors import InputError
 from nmsm.tools.treatment.bounds import RangeRule, check_guess_within, range_bounds
 from nmsm.tools.treatment.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
-from nmsm.tools.treatment.inputs import TreatmentFiles, duration, read_treatment_files
+from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files
 from nmsm.tools.treatment.model_interface import TreatmentModel
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.references import ReferenceSplines
 from nmsm.tools.treatment.solver_options import SolverPlan, plan_from_settings
+from nmsm.tools.treatment.term_defaults import default_error_warnings
 
 #: settings attribute of each controller element, in the order controls are laid out
 CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMuscleController", "muscle_controller"),
@@ -253,6 +254,12 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     else:
         lo_t = hi_t = tf_guess = t_ref
         t_guess = t_ref if options.guess_directory is None else t_guess
+    time_problems = guess_time_problems(guess_files, t_guess)
+    if time_problems:
+        warnings.warn(f"{settings.settings_file}: the initial guess does not cover the problem's time range (it is "
+                      "read from its own start over the problem's duration, so IPOPT would start from another motion "
+                      "than the tracked one; give a guess on the tracked data's times):\n  "
+                      + "\n  ".join(time_problems), stacklevel=2)
     mesh = plan.mesh
     setup = ControllerSetup(
         tool=tool, model=model, collocation_times=mesh.times("collocation") * t_ref, reference_duration=t_ref,
@@ -281,6 +288,8 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     if problems:
         warnings.warn(f"{settings.settings_file}: the initial guess violates variable bounds (IPOPT starts from the "
                       "projection onto the bounds):\n  " + "\n  ".join(problems), stacklevel=2)
+    for message in default_error_warnings(settings.cost_terms, tool):
+        warnings.warn(message, stacklevel=2)
     terms = build_terms(list(settings.cost_terms), tool) + build_terms(list(settings.constraint_terms), tool)
     messages = _formulation_warnings(tool, states, terms, controllers)
     for message in messages:
@@ -288,4 +297,4 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     built = build_problem(data, mesh, state_setup, terms, name=f"{tool}_{settings.trial_name}",
                           normalize_cost_by_term_type=settings.normalize_cost_by_term_type,
                           parallel=options.parallel, declare_extra=declare_extra)
-    return Prepared(settings, tool, plan, model, files, data, built, terms, problems + messages)
+    return Prepared(settings, tool, plan, model, files, data, built, terms, time_problems + problems + messages)
