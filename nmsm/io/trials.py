@@ -1,8 +1,12 @@
 """Find a trial's files in a data folder by its prefix.
 
 The original matches prefixes as substrings, so ``gait_1`` also matches ``gait_10``. Here
-an exact stem match wins (``gait_1.sto``); a substring match is used only when exactly one
-entry contains the prefix; several candidates are an error listing them.
+an exact stem match wins (``gait_1.sto``); else a name containing the prefix is used when it
+is the only one (``gait_1_muscleActivations.sto``, ``S01_gait_1.mot``), but the prefix never
+runs into a neighbouring digit: a prefix ending in a digit does not match where another
+digit follows (``gait_1`` is not in ``gait_10.sto``), one starting with a digit not where a
+digit precedes (``1_gait`` is not in ``11_gait.sto``) (:func:`contains_trial`). Several
+candidates are an error listing them.
 
 Layout (tools.md §0.2): ``<data>/IKData/<prefix>.sto``, ``IDData/``, ``EMGData/``,
 ``GRFData/``, ``MAData/<prefix>/<prefix>_..._Length.sto`` etc.
@@ -39,6 +43,25 @@ def trial_prefixes(directory: str | os.PathLike[str], extensions: Sequence[str] 
     return [p.stem for p in _entries(Path(directory), folders=False, extensions=tuple(e.lower() for e in extensions))]
 
 
+def contains_trial(name: str, prefix: str) -> bool:
+    """Whether file or folder ``name`` contains trial ``prefix`` without running into a digit.
+
+    ``gait_1`` is in ``gait_1_ID.sto`` and ``S01_gait_1.mot``, not in ``gait_10.sto``;
+    ``1_gait`` is not in ``11_gait.sto``.
+    """
+    if not prefix:
+        return False
+    start = name.find(prefix)
+    while start >= 0:
+        end = start + len(prefix)
+        digit_before = prefix[0].isdigit() and start > 0 and name[start - 1].isdigit()
+        digit_after = prefix[-1].isdigit() and end < len(name) and name[end].isdigit()
+        if not (digit_before or digit_after):
+            return True
+        start = name.find(prefix, start + 1)
+    return False
+
+
 def _match(candidates: list[Path], prefix: str, key, directory: Path, what: str) -> Path:
     exact = [p for p in candidates if key(p) == prefix]
     if len(exact) == 1:
@@ -49,7 +72,7 @@ def _match(candidates: list[Path], prefix: str, key, directory: Path, what: str)
             file=directory,
             expected=f"one {what} per trial",
         )
-    containing = [p for p in candidates if prefix in p.name]
+    containing = [p for p in candidates if contains_trial(p.name, prefix)]
     if len(containing) == 1:
         return containing[0]
     if not containing:
@@ -57,7 +80,7 @@ def _match(candidates: list[Path], prefix: str, key, directory: Path, what: str)
         raise InputError(
             f"no {what} for trial '{prefix}' (found: {names})",
             file=directory,
-            expected=f"a {what} whose name is, or contains, '{prefix}'",
+            expected=f"a {what} whose name is, or contains, '{prefix}' (not next to another digit)",
         )
     raise InputError(
         f"trial '{prefix}' is ambiguous: {', '.join(p.name for p in containing)} all contain it",
@@ -69,7 +92,8 @@ def _match(candidates: list[Path], prefix: str, key, directory: Path, what: str)
 def find_trial_file(
     directory: str | os.PathLike[str], prefix: str, *, extensions: Sequence[str] = TABLE_EXTENSIONS
 ) -> Path:
-    """The table of trial ``prefix`` in ``directory`` (exact stem, else unique substring)."""
+    """The table of trial ``prefix`` in ``directory`` (exact stem, else the one name containing it, see
+    :func:`contains_trial`)."""
     directory = Path(directory)
     exts = tuple(e.lower() for e in extensions)
     return _match(_entries(directory, folders=False, extensions=exts), prefix, lambda p: p.stem, directory, "file")

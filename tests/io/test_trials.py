@@ -59,3 +59,31 @@ def test_file_by_suffix(data: Path) -> None:
     assert found.name == "gait_1_MuscleAnalysis_MomentArm_knee_angle_r.sto"
     with pytest.raises(InputError, match="no file ending"):
         find_file_by_suffix(folder, "_Velocity")
+
+
+def test_prefix_never_runs_into_another_digit(tmp_path: Path) -> None:
+    """mtp19: without gait_1.sto, trial gait_1 must not take gait_10.sto (nor 1_gait take 11_gait.sto)."""
+    ik = tmp_path / "IKData"
+    ik.mkdir()
+    for name in ("gait_10.sto", "11_gait.sto"):
+        (ik / name).write_text("x")
+    with pytest.raises(InputError) as info:
+        find_trial_file(ik, "gait_1")
+    assert "no file for trial 'gait_1' (found: 11_gait.sto, gait_10.sto)" in info.value.detail
+    with pytest.raises(InputError, match="no file for trial '1_gait'"):
+        find_trial_file(ik, "1_gait")
+    ma = tmp_path / "MAData"
+    (ma / "gait_10").mkdir(parents=True)
+    with pytest.raises(InputError, match=r"no folder for trial 'gait_1' \(found: gait_10\)"):
+        find_trial_folder(ma, "gait_1")
+
+
+def test_prefix_with_a_suffix_still_matches(tmp_path: Path) -> None:
+    """Real layouts name files <trial>_<what> (mtpResults/gait_1_muscleActivations.sto)."""
+    folder = tmp_path / "muscleActivations"
+    folder.mkdir()
+    for name in ("gait_1_muscleActivations.sto", "gait_10_muscleActivations.sto", "speed1_gait_2_ID.mot"):
+        (folder / name).write_text("x")
+    assert find_trial_file(folder, "gait_1").name == "gait_1_muscleActivations.sto"
+    assert find_trial_file(folder, "gait_2").name == "speed1_gait_2_ID.mot"
+    assert find_trial_file(folder, "gait_10").name == "gait_10_muscleActivations.sto"

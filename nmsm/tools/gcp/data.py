@@ -2,7 +2,8 @@
 reactions of each foot's force columns, on each foot's own time window.
 
 Time grids: the motion's frames inside ``[start_time, end_time]`` define the window; they
-must be evenly spaced (the kinematics are B-splines on equal increments). Each frame takes
+must be evenly spaced (the kinematics are B-splines on equal increments). A window reaching
+beyond the motion warns and uses the motion's frames inside it. Each frame takes
 the ground-reaction row within 5 ms of it (tools.md §6.1). When the two files are sampled
 differently (no such row), the ground reactions are linearly interpolated onto the motion
 frames, with a warning; when they do not cover the window, or the motion is unevenly
@@ -22,6 +23,7 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, read_storage
 from nmsm.model.components import GROUND, Model
+from nmsm.io.motion_units import warn_implausible_angles
 
 #: largest time difference (s) between a motion frame and its ground-reaction row
 TIME_MATCH_TOLERANCE = 5e-3
@@ -42,9 +44,11 @@ class GroundReactions:
 
 
 def read_motion(path: Path, model: Model) -> Table:
-    """The motion file in radians (rotational model coordinates converted from degrees)."""
+    """The motion file in radians (rotational model coordinates converted from degrees); a
+    header whose unit looks wrong warns (:mod:`nmsm.io.motion_units`)."""
     table = read_storage(path)
-    rotational = {c.name for c in model.coordinates if c.is_rotational}
+    rotational = {c.name: c.range for c in model.coordinates if c.is_rotational}
+    warn_implausible_angles(table, rotational, file=path)
     return table.to_radians(rotational)
 
 
@@ -53,15 +57,28 @@ def read_ground_reactions(path: Path, electrical_center_columns: set[str]) -> Ta
     return read_storage(path, allow_nan=lambda label: label in electrical_center_columns)
 
 
-def window_indices(time: np.ndarray, start: float, end: float, *, file: Path, element: str) -> np.ndarray:
+def window_indices(time: np.ndarray, start: float, end: float, *, file: Path, element: str,
+                   settings_file: Path | str | None = None) -> np.ndarray:
     """Indices of the frames with ``start <= t <= end`` (1e-9 s slack); at least 2 frames
-    evenly spaced, else :class:`InputError`."""
+    evenly spaced, else :class:`InputError`. A window reaching more than half a frame
+    beyond the motion warns (``settings_file``, ``element``, requested and available range)
+    and keeps the motion's frames inside it."""
     slack = 1e-9
     idx = np.flatnonzero((time >= start - slack) & (time <= end + slack))
     if idx.size < 2:
         raise InputError(f"fewer than 2 frames of the motion lie in [{start}, {end}] s "
-                         f"(file covers {time[0]}..{time[-1]} s)", file=file, element=element,
+                         f"(file covers {time[0]}..{time[-1]} s)", file=file,
+                         element=f"{element}: <start_time>/<end_time>",
                          expected="start_time and end_time inside the motion's time range")
+    half_frame = 0.5 * float(np.median(np.diff(time)))
+    beyond = [name for name, out in (("<start_time>", start < time[0] - half_frame),
+                                     ("<end_time>", end > time[-1] + half_frame)) if out]
+    if beyond:
+        where = f"{settings_file}: " if settings_file else ""
+        verb = "ask" if len(beyond) > 1 else "asks"
+        warnings.warn(f"{where}{element}: {' and '.join(beyond)} {verb} for {start:g}-{end:g} s but the motion {file} "
+                      f"covers {time[0]:g}-{time[-1]:g} s; using its frames in {time[idx[0]]:g}-{time[idx[-1]]:g} s",
+                      stacklevel=3)
     steps = np.diff(time[idx])
     mean = float(steps.mean())
     if np.abs(steps - mean).max() > EVEN_SPACING_TOLERANCE * mean:

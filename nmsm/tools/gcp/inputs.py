@@ -146,7 +146,8 @@ def build_foot_inputs(index: int, surface: ContactSurfaceSettings, settings: Gro
     foot = FootModel(model, surface.hindfoot_body, foot_markers(surface), surface.is_left_foot,
                      settings_file=settings_file)
     rows = window_indices(motion.time, surface.start_time, surface.end_time, file=settings.input_motion_file,
-                          element=f"<GCPContactSurface> {surface.name or index}: <start_time>/<end_time>")
+                          element=f"<GCPContactSurface> {surface.name or index}",
+                          settings_file=settings.settings_file)
     time = motion.time[rows]
     q_full = full_coordinates(motion, model, rows, foot.hindfoot_body, motion_file=settings.input_motion_file)
     coordinates = experimental_foot_coordinates(casadi_model, q_full, foot)

@@ -41,6 +41,7 @@ from nmsm.tools.jmp.ik_settings import CoordinateTask, IkSettings, read_ik_setti
 from nmsm.tools.jmp.levenberg_marquardt import DenseJacobian, Tolerances, solve
 from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, select_trial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
+from nmsm.io.motion_units import warn_implausible_angles
 
 #: OpenSim's default IK accuracy
 DEFAULT_ACCURACY = 1e-5
@@ -114,8 +115,10 @@ def _coordinate_targets(model: Model, tasks: Sequence[CoordinateTask], times: np
                 raise InputError(f"IK coordinate task '{task.name}' takes its value from_file but no coordinate file "
                                  "is given", element="<coordinate_file>", expected="a .mot/.sto of coordinates")
             if motion is None:
-                motion = read_storage(coordinate_file).to_radians(
-                    {c.name for c in model.coordinates if c.motion_type == "rotational"})
+                rotational = {c.name: c.range for c in model.coordinates if c.motion_type == "rotational"}
+                motion = read_storage(coordinate_file)
+                warn_implausible_angles(motion, rotational, file=coordinate_file, stacklevel=4)
+                motion = motion.to_radians(rotational)
             column = np.interp(times, motion.time, motion.column(task.name))
         names.append(task.name)
         weights.append(task.weight)
@@ -148,6 +151,7 @@ def inverse_kinematics(
     initial: np.ndarray | None = None,
     check_marker_units: bool = True,
     kinematics: MarkerKinematics | None = None,
+    time_range_source: str | os.PathLike[str] | None = None,
 ) -> IkResult:
     """Inverse kinematics of a marker trial (see module docstring).
 
@@ -163,7 +167,8 @@ def inverse_kinematics(
     factor. ``initial``: free-coordinate start of the first frame (default: the model's
     default pose). ``check_marker_units``: detect mm/m mix-ups (:func:`check_units`).
     ``kinematics``: a :class:`MarkerKinematics` already built for these markers (and
-    parameters), to save building it again.
+    parameters), to save building it again. ``time_range_source``: the settings file that
+    gave ``time_range`` (named when the range reaches beyond the markers).
     """
     if not isinstance(model, Model):
         model = load_model(model)
@@ -174,7 +179,8 @@ def inverse_kinematics(
             trial = attrs.evolve(trial, time=trial.time[keep], positions=trial.positions[keep])
     else:
         table = markers if isinstance(markers, MarkerTable) else read_trc(markers)
-        trial = select_trial(table, model, weights, time_range=time_range)
+        trial = select_trial(table, model, weights, time_range=time_range,
+                             time_range_source=None if time_range_source is None else str(time_range_source))
     task_names = [t.name for t in coordinate_tasks]
     if kinematics is not None:
         if kinematics.marker_names != tuple(trial.names) or not set(task_names) <= set(kinematics.free_names):
@@ -298,6 +304,7 @@ def run_ik_files(model_file: str | os.PathLike[str], marker_file: str | os.PathL
         coordinate_file=settings.coordinate_file if settings else None,
         time_range=time_range if time_range is not None else (settings.time_range if settings else None),
         accuracy=accuracy if accuracy is not None else (settings.accuracy if settings else None),
+        time_range_source=settings.file if time_range is None and settings is not None else None,
     )
     if output is not None:
         write_motion(output, result)

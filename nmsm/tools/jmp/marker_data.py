@@ -12,6 +12,7 @@ gap, so that marker is dropped from that frame, as OpenSim does.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Mapping
 
@@ -66,13 +67,16 @@ def _where(table: MarkerTable) -> str | None:
 
 def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] | None = None, *,
                  time_range: tuple[float, float] | None = None, settings_file: str | None = None,
-                 element: str = "<marker_names>") -> MarkerTrial:
+                 element: str = "<marker_names>", time_range_source: str | None = None) -> MarkerTrial:
     """The markers and frames used.
 
     ``weights`` (marker -> weight > 0) names the markers explicitly: each must be in the
     marker file and in the model, else :class:`InputError` naming ``settings_file`` and
     ``element``. Without ``weights``, every marker of both the file and the model is used
-    with weight 1 (OpenSim's default). ``time_range`` (s, inclusive) selects frames.
+    with weight 1 (OpenSim's default). ``time_range`` (s, inclusive) selects frames; a
+    finite end reaching more than half a frame beyond the marker data warns, naming
+    ``time_range_source`` (default ``settings_file``), ``<time_range>``, the requested and
+    the available range.
     """
     if weights is None:
         names = [n for n in table.names if n in set(model.marker_names)]
@@ -109,6 +113,7 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
             raise InputError(f"no frame of the marker file lies in the time range {start:g}-{end:g} s "
                              f"(the file covers {time[0]:g}-{time[-1]:g} s)", file=settings_file or _where(table),
                              element="<time_range>", expected="a time range overlapping the marker data")
+        _warn_range_beyond_data(time, start, end, keep, time_range_source or settings_file, table)
         time, positions = time[keep], positions[keep]
     present = np.all(np.isfinite(positions), axis=2)
     never = [n for k, n in enumerate(names) if not present[:, k].any()]
@@ -117,6 +122,19 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
                       "(weight 0 in every frame)", stacklevel=2)
     return MarkerTrial(time=np.array(time), names=tuple(names), positions=np.array(positions),
                        weights=values, source=_where(table))
+
+
+def _warn_range_beyond_data(time: np.ndarray, start: float, end: float, keep: np.ndarray, source: str | None,
+                            table: MarkerTable) -> None:
+    half_frame = 0.5 * float(np.median(np.diff(time))) if time.size > 1 else 0.0
+    beyond = ((math.isfinite(start) and start < time[0] - half_frame)
+              or (math.isfinite(end) and end > time[-1] + half_frame))
+    if not beyond:
+        return
+    used = time[keep]
+    where = f"{source}: " if source else ""
+    warnings.warn(f"{where}<time_range> {start:g}-{end:g} s reaches beyond the marker data {_where(table)} "
+                  f"({time[0]:g}-{time[-1]:g} s); using its frames in {used[0]:g}-{used[-1]:g} s", stacklevel=4)
 
 
 def _spread(points: np.ndarray) -> float:

@@ -9,7 +9,8 @@ Example (the tutorial's step 2)::
 
 ``--markers`` computes IK, ``--external-loads`` computes ID and ``--compute-muscle-analysis``
 the muscle analysis, with nmsm's model core (``--engine nmsm``, default) or OpenSim
-(``--engine opensim``).
+(``--engine opensim``). Arguments, output folder and inputs are checked before anything is
+processed, and nothing is left behind on an error (:mod:`nmsm.tools.preprocess.command`).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ def _path(value: str | None) -> Path | None:
 
 
 def _preprocess(args: argparse.Namespace) -> int:
-    from nmsm.tools.preprocess.run import EmgOptions, PreprocessRequest, parse_time_pairs, preprocess
+    from nmsm.tools.preprocess.command import run_checked
+    from nmsm.tools.preprocess.run import EmgOptions, PreprocessRequest, parse_time_pairs
 
     request = PreprocessRequest(
         time_pairs=parse_time_pairs(args.time_pair),
@@ -50,7 +52,7 @@ def _preprocess(args: argparse.Namespace) -> int:
         muscles=tuple(args.muscles.split()) if args.muscles else (),
         coordinates=tuple(args.coordinates.split()) if args.coordinates else (),
     )
-    names = preprocess(request)
+    names = run_checked(request)
     print(f"wrote {len(names)} trial(s) to {request.output}: {', '.join(names)}")
     return 0
 

@@ -11,6 +11,9 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.signal import butter
 
@@ -39,17 +42,26 @@ def lowpass(time: np.ndarray, data: np.ndarray, cutoff: float, order: int = 4) -
     return matlab_filtfilt(b, a, x - mean) + mean
 
 
+def check_covers(time: np.ndarray, windows: Sequence[tuple[float, float]], *, what: str,
+                 file: str | os.PathLike[str] | None) -> None:
+    """:class:`InputError` naming ``file`` when the samples ``time`` (s) do not span every
+    window ``(start, end)`` (s; 1e-9 relative slack)."""
+    lo, hi = float(time[0]), float(time[-1])
+    tol = 1e-9 * max(1.0, abs(hi))
+    for start, end in windows:
+        if start < lo - tol or end > hi + tol:
+            raise InputError(
+                f"{what} covers {lo:g}-{hi:g} s but the trial needs {start:g}-{end:g} s",
+                file=file,
+                expected="data spanning every time pair (EMG: the pair widened by the padding)",
+            )
+
+
 def resample(table: Table, times: np.ndarray, *, what: str = "table") -> np.ndarray:
     """Natural quintic spline of every column of ``table`` evaluated at ``times`` (m,): (m, k)."""
     t = np.asarray(times, dtype=float)
+    check_covers(table.time, [(t[0], t[-1])], what=what, file=table.source)
     lo, hi = table.time[0], table.time[-1]
-    tol = 1e-9 * max(1.0, abs(hi))
-    if t[0] < lo - tol or t[-1] > hi + tol:
-        raise InputError(
-            f"{what} covers {lo:g}-{hi:g} s but the trial needs {t[0]:g}-{t[-1]:g} s",
-            file=table.source,
-            expected="data spanning every time pair (EMG: the pair widened by the padding)",
-        )
     values, _, _ = quintic_spline(table.time, table.data, np.clip(t, lo, hi))
     return values
 

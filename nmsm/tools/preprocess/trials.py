@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from pathlib import Path
 
 import attrs
@@ -33,6 +33,7 @@ import numpy as np
 
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, write_storage
+from nmsm.io.motion_units import warn_implausible_angles
 from nmsm.tools.preprocess.signals import lowpass, resample, resample_with_gaps
 from nmsm.tools.preprocess.tables import read_table
 
@@ -46,7 +47,9 @@ SourceLike = Path | Table | None
 class TrialSources:
     """Inputs of :func:`split_into_trials` (paths or tables); any may be None (then not written).
 
-    ``rotational``: the model's rotational coordinate names (for IK in degrees).
+    ``rotational``: the model's rotational coordinate names (for IK in degrees), or a mapping
+    name -> range ``(min, max)`` (rad) of them; given, the IK file's ``inDegrees`` header is
+    checked for plausibility (:mod:`nmsm.io.motion_units`).
     ``muscle_analysis``: folder with ``*_Length.sto``, ``*_Velocity.sto``,
     ``*_MomentArm_<coordinate>.sto`` (OpenSim MuscleAnalysis names).
     """
@@ -56,7 +59,12 @@ class TrialSources:
     grf: SourceLike = None
     emg: SourceLike = None
     muscle_analysis: Path | None = None
-    rotational: Collection[str] = ()
+    rotational: Collection[str] | Mapping[str, tuple[float, float]] = ()
+
+
+def ground_reaction_nan(label: str) -> bool:
+    """NaN is allowed in centre-of-pressure columns of ground-reaction files (swing)."""
+    return label.endswith(("_px", "_py", "_pz"))
 
 
 def padding_frames(time_pairs: Sequence[tuple[float, float]], rows: int = 101,
@@ -66,12 +74,22 @@ def padding_frames(time_pairs: Sequence[tuple[float, float]], rows: int = 101,
     return int(math.ceil(round(padding_time / (shortest / (rows - 1)), 9)))
 
 
-def check_time_pairs(time_pairs: Sequence[tuple[float, float]]) -> None:
+def check_time_pairs(time_pairs: Sequence[tuple[float, float]], element: str = "time pairs") -> None:
+    """:class:`InputError` for no pair, a non-finite time or a pair that does not increase."""
     if not time_pairs:
-        raise InputError("no time pairs", element="time pairs", expected="at least one 'start end' pair (s)")
+        raise InputError("no time pairs", element=element, expected="at least one 'start end' pair (s)")
     for t0, t1 in time_pairs:
+        if not (math.isfinite(t0) and math.isfinite(t1)):
+            raise InputError(f"time pair {t0} {t1} is not finite", element=element, expected="finite times (s)")
         if not t1 > t0:
-            raise InputError(f"time pair {t0} {t1} does not increase", element="time pairs", expected="start < end (s)")
+            raise InputError(f"time pair {t0} {t1} does not increase", element=element, expected="start < end (s)")
+
+
+def emg_windows(time_pairs: Sequence[tuple[float, float]], rows: int = 101,
+                padding_time: float = EMG_PADDING_SECONDS) -> list[tuple[float, float]]:
+    """The EMG windows (s): each pair widened by ``pad / (rows - 1) (t1 - t0)`` each side."""
+    pad = padding_frames(time_pairs, rows, padding_time)
+    return [(t0 - pad / (rows - 1) * (t1 - t0), t1 + pad / (rows - 1) * (t1 - t0)) for t0, t1 in time_pairs]
 
 
 def _write(path: Path, like: Table, time: np.ndarray, values: np.ndarray, *, in_degrees: bool = False,
@@ -156,6 +174,8 @@ def split_into_trials(
                          expected="one name per time pair")
     if sources.ik is not None:
         table = read_table(sources.ik)
+        if sources.rotational:
+            warn_implausible_angles(table, sources.rotational)
         degrees = table.in_degrees
         if degrees and ik_radians:
             if not sources.rotational:
@@ -169,7 +189,7 @@ def split_into_trials(
         for name, (t, v) in zip(names, _section(_filtered(table, cutoff, filter_order), time_pairs, rows, "ID")):
             _write(out / "IDData" / f"{name}.sto", table, t, v)
     if sources.grf is not None:
-        table = read_table(sources.grf, allow_nan=lambda label: label.endswith(("_px", "_py", "_pz")))
+        table = read_table(sources.grf, allow_nan=ground_reaction_nan)
         for name, (t, v) in zip(names, _section_with_gaps(table, time_pairs, rows, "GRF")):
             _write(out / "GRFData" / f"{name}.sto", table, t, v, allow_nan=True)
     if sources.muscle_analysis is not None:
@@ -185,13 +205,12 @@ def split_into_trials(
     if sources.emg is not None:
         table = read_table(sources.emg)
         pad = padding_frames(time_pairs, rows, emg_padding_time)
-        for name, (t0, t1) in zip(names, time_pairs):
-            widen = pad / (rows - 1) * (t1 - t0)
-            times = np.linspace(t0 - widen, t1 + widen, rows + 2 * pad)
+        for name, (start, end) in zip(names, emg_windows(time_pairs, rows, emg_padding_time)):
+            times = np.linspace(start, end, rows + 2 * pad)
             values = resample(table, times, what="EMG")
             _write(out / "EMGData" / f"{name}.sto", table, times, np.clip(values, 0.0, None) if clip_emg else values)
     return names
 
 
-__all__ = ["EMG_PADDING_SECONDS", "TrialSources", "check_time_pairs", "ma_files", "padding_frames",
-           "split_into_trials"]
+__all__ = ["EMG_PADDING_SECONDS", "TrialSources", "check_time_pairs", "emg_windows", "ground_reaction_nan",
+           "ma_files", "padding_frames", "split_into_trials"]

@@ -6,13 +6,14 @@ from __future__ import annotations
 import shutil
 import warnings
 
+import attrs
 import numpy as np
 import pytest
 
 from nmsm.errors import InputError, ModelError
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
-from nmsm.io.storage import read_storage, table_from_columns, write_storage
+from nmsm.io.storage import format_storage, read_storage, table_from_columns, write_storage
 from nmsm.tools.gcp.run import load_feet
 
 
@@ -141,4 +142,43 @@ def test_vertical_force_with_the_wrong_sign(case):
     assert "grf.sto" in str(err.value)
     _rewrite_forces(case / "grf.sto", f1_vx=0.0, f1_vz=0.0)  # no horizontal force to compare with: the sign decides
     with pytest.raises(InputError, match="'f1_vy' is not the vertical.*negative in 100% of the loaded frames"):
+        _load(case)
+
+
+def test_window_beyond_the_motion_warns(case):
+    """gcp04: <end_time> past the motion's end is cut, and the warning says so."""
+    motion = read_storage(case / "ik.sto")
+    with pytest.warns(UserWarning) as record:
+        feet, *_ = _load(case, **{"<end_time>0.6</end_time>": "<end_time>2.0</end_time>"})
+    messages = [str(w.message) for w in record if "asks for" in str(w.message)]
+    assert len(messages) == 1
+    assert "settings.xml" in messages[0] and "<end_time>" in messages[0] and "<start_time>" not in messages[0]
+    assert f"<end_time> asks for 0-2 s but the motion {case / 'ik.sto'} covers 0-{motion.time[-1]:g} s" in messages[0]
+    assert feet[0].time[-1] == pytest.approx(motion.time[-1])
+
+
+def test_window_inside_the_motion_is_silent(case):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        feet, *_ = _load(case)
+    assert feet[0].n_frames > 2
+
+
+def test_motion_header_in_the_wrong_unit_warns(case):
+    """gcp07 / pre04: a degrees file marked radians (and the reverse) is named with the column and both units."""
+    motion = read_storage(case / "ik.sto")
+    rotational = [k for k in motion.labels if "rotation" in k or k.startswith("mtp")]
+    degrees = motion.data.copy()
+    for k in rotational:
+        degrees[:, motion.labels.index(k)] = np.rad2deg(degrees[:, motion.labels.index(k)])
+    (case / "ik.sto").write_text(format_storage(attrs.evolve(motion, data=degrees, in_degrees=False)))
+    with pytest.warns(UserWarning, match=r"ik.sto: read with inDegrees=no, rotational column\(s\) '.*' .* rad "
+                                         r"\(.* deg\), outside \[-2π, 2π\] rad.*header may be wrong"):
+        _load(case)
+    scaled = motion.data.copy()
+    for k in rotational:
+        scaled[:, motion.labels.index(k)] *= 3.0  # radians, moving enough to tell, marked degrees
+    (case / "ik.sto").write_text(format_storage(attrs.evolve(motion, data=scaled, in_degrees=True)))
+    with pytest.warns(UserWarning, match=r"ik.sto: inDegrees=yes, but every rotational column as written lies "
+                                         r"within \[-π, π\].*look like radians"):
         _load(case)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 from lxml import etree
 
@@ -73,3 +75,23 @@ def test_results_never_overwrite_an_input(case):
     with pytest.raises(InputError, match="overwrite an input"):
         run_settings(case.settings_file, quiet=True)
     assert case.nominal_model.read_bytes() == before
+
+
+def test_time_range_beyond_the_markers_warns(case):
+    """jmp05: <time_range> 0 7 on 0-0.3 s of markers is cut to the data, and the warning says so."""
+    _edit(case, lambda task: etree.SubElement(task, "time_range").__setattr__("text", "0 7"))
+    with pytest.warns(UserWarning) as record:
+        run_settings(case.settings_file, quiet=True)
+    messages = [str(w.message) for w in record if "<time_range>" in str(w.message)]
+    assert len(messages) == 1
+    message = messages[0]
+    assert message.startswith(f"{case.settings_file}: <time_range> 0-7 s reaches beyond the marker data")
+    assert "markers.trc (0-0.3 s); using its frames in 0-0.3 s" in message
+
+
+def test_time_range_inside_the_markers_is_silent(case):
+    _edit(case, lambda task: etree.SubElement(task, "time_range").__setattr__("text", "0 0.3"))
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_settings(case.settings_file, quiet=True)
+    assert not [w for w in record if "<time_range>" in str(w.message)]
