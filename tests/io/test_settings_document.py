@@ -91,6 +91,33 @@ def test_getter_errors_name_file_line_and_element(tmp_path: Path) -> None:
         doc.integer(doc.child(tool, "RCNLTorqueController"), "epsilon")
 
 
+def test_missing_required_element_names_a_misspelled_one(tmp_path: Path) -> None:
+    path = _write(tmp_path, DOC.replace("<trial_name> gait_1 </trial_name>", "<trial_nmae> gait_1 </trial_nmae>"))
+    doc = read_settings_document(path)
+    with pytest.raises(InputError, match=r"required element <trial_name> is missing in <TrackingOptimizationTool> "
+                                         r"\(found <trial_nmae> at line 4: did you mean <trial_name>\?\)"):
+        doc.text(doc.tool_element, "trial_name", required=True)
+    with pytest.raises(InputError) as info:  # nothing close: no hint
+        doc.text(doc.tool_element, "input_model_file", required=True)
+    assert "did you mean" not in str(info.value)
+
+
+def test_mtp_settings_with_a_misspelled_required_element(shared_data: Path, tmp_path: Path) -> None:
+    from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings
+
+    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
+    (tmp_path / "CompletedSettingsFiles").mkdir()
+    for name in ("UF_Subject_3_reduced_muscles.osim", "preprocessed"):  # what the paths resolve against
+        (tmp_path / name).symlink_to(tutorial / name)
+    source = tutorial / "CompletedSettingsFiles" / "MTPSettingsV3.xml"
+    path = _write(tmp_path / "CompletedSettingsFiles", source.read_text().replace("coordinate_list>", "coordinate_lst>"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(InputError, match=r"<coordinate_list> is missing .*found <coordinate_lst> at line \d+: "
+                                             r"did you mean <coordinate_list>\?"):
+            MuscleTendonPersonalizationSettings.from_document(read_settings_document(path))
+
+
 def test_lookup_direct_child_versus_original_depth_first(tmp_path: Path) -> None:
     doc = read_settings_document(_write(tmp_path, DOC))
     tool = doc.tool_element

@@ -17,6 +17,8 @@ file, the parent's line and the element. Only the literal text ``true`` is true 
 
 from __future__ import annotations
 
+import difflib
+
 import os
 import warnings
 from collections.abc import Iterator, Sequence
@@ -137,6 +139,16 @@ class SettingsDocument:
                 return element
         return None
 
+    def misspelling_hint(self, parent: etree._Element, name: str) -> str:
+        """`` (found <nmae> at line N: did you mean <name>?)`` when a child of ``parent`` that is
+        not ``<name>`` is spelled close to it (a required element reported missing), else ``""``."""
+        others = [child for child in parent if isinstance(child.tag, str) and child.tag != name]
+        close = difflib.get_close_matches(name, [child.tag for child in others], n=1, cutoff=0.75)
+        if not close:
+            return ""
+        found = next(child for child in others if child.tag == close[0])
+        return f" (found <{found.tag}> at line {found.sourceline}: did you mean <{name}>?)"
+
     def text_of(self, element: etree._Element | None) -> str:
         return "" if element is None else (element.text or "").strip()
 
@@ -145,9 +157,10 @@ class SettingsDocument:
         if element is None or self.text_of(element) == "":
             if required:
                 what = "missing" if element is None else "empty"
+                hint = self.misspelling_hint(parent, name) if element is None else ""
                 raise self.error(
                     element if element is not None else parent,
-                    f"required element <{name}> is {what} in <{parent.tag}>",
+                    f"required element <{name}> is {what} in <{parent.tag}>{hint}",
                     element=f"<{name}>",
                     expected=f"<{name}> with a value",
                 )

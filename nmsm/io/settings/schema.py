@@ -175,7 +175,8 @@ def _read_blocks(doc: SettingsDocument, parent: etree._Element, spec: Setting) -
         if spec.required:
             raise doc.error(
                 parent,
-                f"required element <{spec.container}> is missing in <{parent.tag}>",
+                f"required element <{spec.container}> is missing in <{parent.tag}>"
+                + doc.misspelling_hint(parent, spec.container),
                 element=f"<{spec.container}>",
                 expected=f"<{spec.container}> with <{spec.element}> elements",
             )
@@ -280,7 +281,8 @@ def read_block(cls: type, doc: SettingsDocument, element: etree._Element) -> Any
             if spec.required_element and doc.child(parent, name) is None:
                 raise doc.error(
                     parent,
-                    f"required element <{spec.element}> is missing in <{parent.tag}>",
+                    f"required element <{spec.element}> is missing in <{parent.tag}>"
+                    + doc.misspelling_hint(parent, spec.element),
                     element=f"<{spec.element}>",
                     expected=f"<{spec.element}> (it may be empty)",
                 )
@@ -303,7 +305,8 @@ def read_block(cls: type, doc: SettingsDocument, element: etree._Element) -> Any
                 if spec.required:
                     raise doc.error(
                         element,
-                        f"required element <{spec.element}> is missing in <{element.tag}>",
+                        f"required element <{spec.element}> is missing in <{element.tag}>"
+                        + doc.misspelling_hint(element, spec.element),
                         element=f"<{spec.element}>",
                         expected=f"<{spec.element}>",
                     )
@@ -317,7 +320,8 @@ def read_block(cls: type, doc: SettingsDocument, element: etree._Element) -> Any
             if spec.required and doc.child(element, spec.element) is None:
                 raise doc.error(
                     element,
-                    f"required element <{spec.element}> is missing in <{element.tag}>",
+                    f"required element <{spec.element}> is missing in <{element.tag}>"
+                    + doc.misspelling_hint(element, spec.element),
                     element=f"<{spec.element}>",
                     expected=f"<{spec.element}> (it may be empty)",
                 )
