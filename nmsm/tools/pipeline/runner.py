@@ -26,7 +26,11 @@ or a starting input, unless it is that stage's own results read by a later stage
 wired output).
 
 A stop (Ctrl-C, a failure) leaves the finished stages recorded: the next run skips them and
-redoes the stopped one. Results tree::
+redoes the stopped one. A stage that runs again keeps its earlier results in a hidden
+``.<stage>.earlier`` folder until it finishes; if it fails or is stopped without writing
+anything, the earlier results (and settings copy) are put back, still recorded with their
+old inputs, so the next run redoes the stage; if it wrote a diagnosis (a solver failure's
+last iterate), that stays and the earlier results move into its ``superseded/``. Results tree::
 
     <results_directory>/
         pipeline.xml              copy of the pipeline file
@@ -385,9 +389,10 @@ def _require_available(stage: StageSpec, unavailable: dict[str, str]) -> None:
 def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, folder: Path, results: Path,
                digest: str, state: PipelineState, cache: DigestCache, wired: dict[str, str],
                options: dict[str, Any]) -> StageOutcome:
+    earlier_record = state.records.get(stage.name)
+    earlier_settings = settings_file.read_bytes() if settings_file.is_file() else None
+    earlier = _set_aside(folder)  # only a folder the runner wrote, or an empty one (_check_stage_folder)
     state.forget(stage.name)
-    if folder.exists():
-        shutil.rmtree(folder)  # only a folder the runner wrote, or an empty one (_check_stage_folder)
     folder.mkdir(parents=True)
     write_marker(folder, stage.name)
     state.claim(stage.name, _relative(folder, results))
@@ -396,9 +401,15 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
     began = time.perf_counter()
     try:
         result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})
-    except InputError as exc:
-        _point_at_user_settings(exc, settings_file, text, settings)
+    except BaseException as exc:
+        diagnosis = getattr(exc, "last_iterate_path", None) is not None
+        if _restore(folder, earlier, settings_file, earlier_settings, keep=diagnosis) and earlier_record is not None:
+            state.record(earlier_record)  # its input digest differs: the next run redoes the stage
+        if isinstance(exc, InputError):
+            _point_at_user_settings(exc, settings_file, text, settings)
         raise
+    if earlier is not None:
+        shutil.rmtree(earlier)
     wall = time.perf_counter() - began
     outputs = stage.kind.load_outputs()(settings, folder)
     record = StageRecord(
@@ -416,6 +427,43 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
     state.record(record)
     return StageOutcome(stage.name, stage.kind.code, stage.kind.label, RAN, wall, settings_file, folder, outputs,
                         wired, result)
+
+
+def _set_aside(folder: Path) -> Path | None:
+    """Move an existing stage folder to a hidden sibling while the stage runs again (None
+    when there is none), so that a failed or stopped run can put it back."""
+    if not folder.exists():
+        return None
+    aside = folder.with_name(f".{folder.name}.earlier")
+    if aside.exists():
+        shutil.rmtree(aside)
+    folder.rename(aside)
+    return aside
+
+
+def _restore(folder: Path, earlier: Path | None, settings_file: Path, settings: bytes | None, *,
+             keep: bool) -> bool:
+    """After a failed or stopped stage, keep the last finished results; returns whether they
+    are back in place.
+
+    Unless ``keep``, what the run wrote is removed and the earlier results and settings copy
+    are put back. With ``keep`` (a solver failure whose last iterate and diagnosis the tool
+    saved in the stage folder) the run's folder stays, and the earlier results go into its
+    ``superseded/`` (or ``superseded/earlier_stage_run/`` if the tool made one)."""
+    if not keep:
+        shutil.rmtree(folder, ignore_errors=True)
+        if earlier is not None:
+            earlier.rename(folder)
+        if settings is not None:
+            settings_file.write_bytes(settings)
+        return earlier is not None
+    if earlier is not None:
+        target = folder / "superseded"
+        if target.exists():
+            target = target / "earlier_stage_run"
+        target.parent.mkdir(parents=True, exist_ok=True)
+        earlier.rename(target)
+    return False
 
 
 def _point_at_user_settings(exc: InputError, settings_file: Path, text: str, settings: StageSettings) -> None:

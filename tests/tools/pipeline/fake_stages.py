@@ -1,6 +1,7 @@
 """Two fake stage kinds for runner tests: a model *maker* (like JMP) and a *fitter* that
 reads the model and a data folder (like MTP). Each run is logged in :data:`CALLS`; a fitter
-run can be made to stop (``KeyboardInterrupt``) after writing part of its results."""
+run can be made to stop (``KeyboardInterrupt``) after writing part of its results, or to fail
+as a solver does (``SolverError`` after saving a last iterate)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from pathlib import Path
 
 import attrs
 
+from nmsm.errors import SolverError
+
 from nmsm.io.settings.schema import setting
 from nmsm.tools.pipeline.kinds import StageKind, Wire, register_stage_kind, unregister_stage_kind
 from nmsm.tools.pipeline.stage_settings import StageSettings
@@ -18,6 +21,8 @@ from nmsm.tools.pipeline.stage_settings import StageSettings
 CALLS: list[tuple[str, Path]] = []
 #: stage codes whose next run stops half-way
 STOP_NEXT: set[str] = set()
+#: stage codes whose next run fails like a solver, saving ``last_iterate/`` in its results
+FAIL_NEXT: set[str] = set()
 
 
 @attrs.frozen(kw_only=True)
@@ -82,6 +87,12 @@ def run_fitter(settings_file: Path, **options: object) -> str:
     if "fitter" in STOP_NEXT:
         STOP_NEXT.discard("fitter")
         raise KeyboardInterrupt
+    if "fitter" in FAIL_NEXT:
+        FAIL_NEXT.discard("fitter")
+        (results / "part1.txt").unlink()
+        (results / "last_iterate").mkdir()
+        (results / "last_iterate" / "diagnosis.txt").write_text("did not converge\n")
+        raise SolverError("the fit did not converge", last_iterate_path=str(results / "last_iterate"))
     listing = "\n".join(sorted(p.name for p in data.iterdir()))
     (results / "fit_mtp.osimx").write_text(f"<fit>{listing}</fit>\n")
     return "fitted"
@@ -107,6 +118,7 @@ def fake_kinds() -> Iterator[None]:
     """Register the fake kinds for the duration of a test."""
     CALLS.clear()
     STOP_NEXT.clear()
+    FAIL_NEXT.clear()
     register_stage_kind(MAKER)
     register_stage_kind(FITTER)
     try:

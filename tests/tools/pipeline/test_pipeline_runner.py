@@ -11,9 +11,9 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from fake_stages import CALLS, STOP_NEXT, fake_kinds  # noqa: E402
+from fake_stages import CALLS, FAIL_NEXT, STOP_NEXT, fake_kinds  # noqa: E402
 
-from nmsm.errors import InputError  # noqa: E402
+from nmsm.errors import InputError, SolverError  # noqa: E402
 from nmsm.tools.pipeline.runner import RAN, UP_TO_DATE, run_pipeline_file  # noqa: E402
 from nmsm.tools.pipeline.state import MARKER, STATE_FILE  # noqa: E402
 
@@ -105,11 +105,49 @@ def test_stopped_pipeline_resumes_without_redoing_finished_stages(case: Path) ->
         run_pipeline_file(pipeline, log=None)
     state = json.loads((case / "results" / STATE_FILE).read_text())
     assert list(state["stages"]) == ["make"]  # the stopped stage is not recorded
-    assert (case / "results" / "fit" / "part1.txt").exists()  # its partial output is there
+    assert not (case / "results" / "fit").exists()  # nor is its partial output left
     CALLS.clear()
     run = run_pipeline_file(pipeline, log=None)
     assert _statuses(run) == {"make": UP_TO_DATE, "fit": RAN}
     assert [c[0] for c in CALLS] == ["fitter"]
+
+
+def test_a_stopped_or_failed_rerun_keeps_the_stage_s_earlier_results(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    results = case / "results"
+    fit_before, settings_before = _tree(results / "fit"), (results / "fit.xml").read_bytes()
+    (case / "data" / "extra.txt").write_text("new data: the fit runs again")
+    STOP_NEXT.add("fitter")
+    with pytest.raises(KeyboardInterrupt):  # stopped after writing part of its output
+        run_pipeline_file(pipeline, log=None)
+    assert _tree(results / "fit") == fit_before and (results / "fit.xml").read_bytes() == settings_before
+    assert not any(p.name.startswith(".fit") for p in results.iterdir())
+    (case / "maker.xml").write_text((case / "maker.xml").read_text().replace("made.osim", "made.bad"))
+    make_before = _tree(results / "make")
+    with pytest.raises(InputError, match="the maker cannot write .bad files"):  # found by the tool while running
+        run_pipeline_file(pipeline, log=None)
+    assert _tree(results / "make") == make_before
+    (case / "maker.xml").write_text((case / "maker.xml").read_text().replace("made.bad", "made.osim"))
+    CALLS.clear()
+    run = run_pipeline_file(pipeline, log=None)  # the kept results are recorded with their old inputs
+    assert _statuses(run) == {"make": UP_TO_DATE, "fit": RAN}
+    assert "extra.txt" in (results / "fit" / "fit_mtp.osimx").read_text()
+
+
+def test_a_solver_failure_keeps_its_diagnosis_and_the_earlier_results(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run_pipeline_file(pipeline, log=None)
+    fit = case / "results" / "fit"
+    before = _tree(fit)
+    (case / "data" / "extra.txt").write_text("new data: the fit runs again")
+    FAIL_NEXT.add("fitter")
+    with pytest.raises(SolverError, match="last iterate and diagnosis saved in"):
+        run_pipeline_file(pipeline, log=None)
+    assert (fit / "last_iterate" / "diagnosis.txt").is_file()
+    assert {f"superseded/{name}": data for name, data in before.items()} == {
+        name: data for name, data in _tree(fit).items() if name.startswith("superseded/")}
+    assert not (fit / "fit_mtp.osimx").exists()  # nothing at the top looks like a result of this run
 
 
 def test_moved_results_tree_stays_up_to_date(case: Path) -> None:
