@@ -1,7 +1,7 @@
 """Progress lines for long solves.
 
 The command line switches them on (:func:`progress_every`, every 10 s by default; ``nmsm
---no-progress`` turns them off); library calls stay silent unless they do the same. A back end
+--progress 0`` turns them off); library calls stay silent unless they do the same. A back end
 asks :func:`solve_progress` for a reporter and calls :meth:`SolveProgress.tick` once per
 iteration; a line is due only when ``interval`` seconds have passed since the last one (or
 since the solve started), so short solves print nothing::
