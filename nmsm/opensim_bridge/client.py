@@ -89,7 +89,11 @@ class OpenSimBridge:
         self.log_path = self.workdir / "worker.log"
         self._lock = threading.Lock()
         self._proc: subprocess.Popen[bytes] | None = None
-        self._start()
+        try:
+            self._start()
+        except BaseException:  # a failed or interrupted start leaves no worker, pipe or folder
+            self.close()
+            raise
 
     def _start(self) -> None:
         req_r, req_w = os.pipe()
@@ -144,21 +148,42 @@ class OpenSimBridge:
         return payload
 
     def close(self) -> None:
+        """Stop the worker (asked to shut down, killed if it does not within 10 s or if this
+        wait is interrupted), close the pipes and remove the working folder."""
         with self._lock:
-            if self._proc is not None and self._proc.poll() is None:
-                try:
-                    send_message(self._requests, ("shutdown", {}))
-                    self._proc.wait(timeout=10)
-                except (OSError, subprocess.TimeoutExpired):
+            try:
+                if self._proc is not None and self._proc.poll() is None:
+                    try:
+                        send_message(self._requests, ("shutdown", {}))
+                        self._proc.wait(timeout=10)
+                    except (OSError, AttributeError, subprocess.TimeoutExpired):
+                        self._proc.kill()
+                    except KeyboardInterrupt:
+                        self._proc.kill()
+                        raise
+            finally:
+                if self._proc is not None and self._proc.poll() is None:
                     self._proc.kill()
-            for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
-                try:
-                    if stream:
-                        stream.close()
-                except OSError:
-                    pass
-            self._proc = None
-        shutil.rmtree(self.workdir, ignore_errors=True)
+                    try:
+                        self._proc.wait(timeout=10)  # reap the killed worker
+                    except BaseException:  # noqa: BLE001 - already stopping; cleanup goes on
+                        pass
+                for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
+                    try:
+                        if stream:
+                            stream.close()
+                    except OSError:
+                        pass
+                self._proc = None
+                shutil.rmtree(self.workdir, ignore_errors=True)
+
+    def _close_at_exit(self) -> None:
+        """:meth:`close` at interpreter exit, where a Ctrl-C during the worker's shutdown
+        only hurries it (killed) instead of printing a traceback."""
+        try:
+            self.close()
+        except KeyboardInterrupt:
+            pass
 
     def __enter__(self) -> OpenSimBridge:
         return self
@@ -175,5 +200,5 @@ def get_bridge() -> OpenSimBridge:
     global _BRIDGE
     if _BRIDGE is None:
         _BRIDGE = OpenSimBridge()
-        atexit.register(_BRIDGE.close)
+        atexit.register(_BRIDGE._close_at_exit)
     return _BRIDGE
