@@ -14,8 +14,14 @@ import warnings
 from collections.abc import Sequence
 
 from nmsm import __version__
+from nmsm.cli_types import non_negative_float
 from nmsm.core.progress import DEFAULT_INTERVAL, progress_every
 from nmsm.errors import NmsmError
+
+#: options of ``nmsm`` itself: they go before the sub-command (``nmsm --progress 5 id ...``)
+GLOBAL_OPTIONS: tuple[str, ...] = ("--progress", "--traceback")
+#: global options that take a value
+_GLOBAL_VALUES = ("--progress",)
 
 #: modules whose ``register(subparsers)`` adds sub-commands, in help order
 COMMAND_MODULES: tuple[str, ...] = (
@@ -32,6 +38,7 @@ COMMAND_MODULES: tuple[str, ...] = (
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``nmsm`` parser with every sub-command of :data:`COMMAND_MODULES`."""
     parser = argparse.ArgumentParser(
         prog="nmsm",
         description="Neuromusculoskeletal Modeling Pipeline: personalize OpenSim models and optimize treatments.",
@@ -39,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"nmsm {__version__}")
     parser.add_argument("--traceback", action="store_true", help="show Python tracebacks on errors")
     parser.add_argument(
-        "--progress", type=float, default=DEFAULT_INTERVAL, metavar="SECONDS",
+        "--progress", type=non_negative_float, default=DEFAULT_INTERVAL, metavar="SECONDS",
         help=f"print a solver progress line at most every SECONDS while a solve runs (default {DEFAULT_INTERVAL:g}; 0: off)",
     )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -54,8 +61,49 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """Sub-command name -> its parser."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def _misplaced_global_option(parser: argparse.ArgumentParser, argv: Sequence[str]) -> str | None:
+    """The message for a global option written after the sub-command, else None.
+
+    ``nmsm id --progress 5 ...`` would otherwise be reported as "unrecognized arguments" (or
+    as a missing argument, ``5`` having been taken for the model).
+    """
+    commands = _commands(parser)
+    k = 0
+    while k < len(argv) and argv[k] not in commands:
+        if argv[k] == "--":
+            return None
+        k += 2 if argv[k] in _GLOBAL_VALUES else 1
+    if k >= len(argv):
+        return None
+    command, sub = argv[k], commands[argv[k]]
+    rest = argv[k + 1:]
+    for j, token in enumerate(rest):
+        if token == "--":
+            return None
+        option, equals, value = token.partition("=")
+        if option in GLOBAL_OPTIONS and option not in sub._option_string_actions:
+            if option in _GLOBAL_VALUES and not equals:
+                value = rest[j + 1] if j + 1 < len(rest) else "SECONDS"
+            example = f"{option} {value}" if option in _GLOBAL_VALUES else option
+            return (f"{option} goes before the sub-command: nmsm {example} {command} ... "
+                    f"({' and '.join(GLOBAL_OPTIONS)} are options of nmsm itself)")
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    misplaced = _misplaced_global_option(parser, argv)
+    if misplaced:
+        parser.error(misplaced)
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()

@@ -71,7 +71,7 @@ def reference_coordinates(data_dir: os.PathLike[str] | str) -> Table:
 def states_reference_table(bridge: Any, data_dir: os.PathLike[str] | str, cutoff_frequency: float = 6.0) -> Table:
     """The reference MocoTrack tracks (``TabOpLowPassFilter(6)`` of ``referenceCoordinates.sto``,
     computed by OpenSim through the bridge command ``moco_states_reference``), plain labels."""
-    r = bridge.call("moco_states_reference", coordinates_file=str(Path(data_dir) / "referenceCoordinates.sto"),
+    r = bridge.call("moco_states_reference", coordinates_file=str((Path(data_dir) / "referenceCoordinates.sto").resolve()),
                     cutoff_frequency=cutoff_frequency)
     labels = [label.split("/")[-2] if label.startswith("/") else label for label in r["labels"]]
     return Table(time=r["time"], labels=tuple(labels), data=r["data"], in_degrees=False, name=TRIAL)

@@ -14,7 +14,8 @@ its range in radians and degrees and the header, when
   radians (as degrees, the whole motion would stay within ±3.1°).
 
 It is used where motion files are read for a model: preprocessing's IK split, GCP's motion,
-JMP / IK coordinate-task files.
+JMP / IK coordinate-task files, and every motion matched to a model's coordinates by
+:func:`nmsm.model.id_tool.check_motion_columns` (``nmsm id``, ``markers``, ``muscle-analysis``).
 """
 
 from __future__ import annotations

@@ -9,33 +9,45 @@ from typing import Any
 
 import numpy as np
 
+from nmsm.cli_types import finite_float, positive_float
+
 
 def _inverse_dynamics(args: argparse.Namespace) -> int:
-    from nmsm.io.storage import read_storage, write_storage
+    """``nmsm id``: outputs checked, then computed, then written atomically."""
+    from nmsm.io.output_file import check_outputs, existing_inputs, write_output
+    from nmsm.io.storage import format_storage, read_storage
     from nmsm.model import load_model
     from nmsm.model.external_loads import read_external_loads
     from nmsm.model.id_tool import inverse_dynamics_of_motion
 
+    loads = read_external_loads(args.external_loads) if args.external_loads else None
+    inputs = existing_inputs({args.model: "the input model (MODEL)", args.motion: "the input motion (MOTION)",
+                              args.external_loads: "the --external-loads file",
+                              loads.data_file if loads else None: "the data file the --external-loads file names"})
+    output = check_outputs({"-o": args.output}, inputs, example_names={"-o": "id.sto"})["-o"]
     model = load_model(args.model)
     motion = read_storage(args.motion)
-    loads = read_external_loads(args.external_loads) if args.external_loads else None
     time_range = None
     if args.start is not None or args.end is not None:
         time_range = (args.start if args.start is not None else -np.inf, args.end if args.end is not None else np.inf)
     table = inverse_dynamics_of_motion(model, motion, external_loads=loads, lowpass_hz=args.lowpass,
                                        time_range=time_range)
-    write_storage(args.output, table, name="Inverse Dynamics Generalized Forces")
-    print(f"wrote {args.output} ({table.n_rows} frames, {table.n_columns} generalized forces)")
+    write_output(output, format_storage(table, name="Inverse Dynamics Generalized Forces"))
+    print(f"wrote {output} ({table.n_rows} frames, {table.n_columns} generalized forces)")
     return 0
 
 
 def _markers(args: argparse.Namespace) -> int:
+    """``nmsm markers``: the output checked, then computed, then written atomically."""
+    from nmsm.io.output_file import check_outputs, existing_inputs, write_output
     from nmsm.io.storage import read_storage
-    from nmsm.io.trc import MarkerTable, write_trc
+    from nmsm.io.trc import MarkerTable, format_trc
     from nmsm.model import CasadiModel, load_model
     from nmsm.model.id_tool import motion_coordinates
     from nmsm.core.threads import SOLVER_THREADS
 
+    inputs = existing_inputs({args.model: "the input model (MODEL)", args.motion: "the input motion (MOTION)"})
+    output = check_outputs({"-o": args.output}, inputs, example_names={"-o": "markers.trc"})["-o"]
     model = load_model(args.model)
     motion = read_storage(args.motion)
     values, missing = motion_coordinates(model, motion)
@@ -52,8 +64,8 @@ def _markers(args: argparse.Namespace) -> int:
     positions = positions.reshape(3, len(model.markers), n, order="F").transpose(2, 1, 0)
     rate = (n - 1) / (motion.time[-1] - motion.time[0]) if n > 1 else None
     table = MarkerTable(motion.time, tuple(model.marker_names), positions, units=args.units, data_rate=rate)
-    write_trc(args.output, table, units=args.units)
-    print(f"wrote {args.output} ({n} frames, {len(model.markers)} markers)")
+    write_output(output, format_trc(table, units=args.units, file_label=output.name))
+    print(f"wrote {output} ({n} frames, {len(model.markers)} markers)")
     return 0
 
 
@@ -63,9 +75,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("model", type=Path, help="OpenSim model (.osim)")
     p.add_argument("motion", type=Path, help="coordinates over time (IK .mot/.sto; degrees if inDegrees=yes)")
     p.add_argument("--external-loads", type=Path, help="OpenSim ExternalLoads XML (its datafile: GRF .mot)")
-    p.add_argument("--lowpass", type=float, help="low-pass cut-off (Hz) for the coordinates; none by default")
-    p.add_argument("--start", type=float, help="first time (s) to report")
-    p.add_argument("--end", type=float, help="last time (s) to report")
+    p.add_argument("--lowpass", type=positive_float,
+                   help="low-pass cut-off (Hz, > 0) for the coordinates; none by default")
+    p.add_argument("--start", type=finite_float, help="first time (s) to report")
+    p.add_argument("--end", type=finite_float, help="last time (s) to report")
     p.add_argument("-o", "--output", type=Path, required=True, help="generalized forces (.sto)")
     p.set_defaults(func=_inverse_dynamics)
 

@@ -8,6 +8,11 @@ inverse dynamics (muscles excluded; contact forces of the model included) at the
 own times. The result is a :class:`~nmsm.io.storage.Table` labelled as OpenSim labels
 it: ``<coordinate>_moment`` for rotational and ``<coordinate>_force`` for translational
 and coupled coordinates, in multibody tree order, N m and N.
+
+The motion is matched to the model's coordinates by :func:`check_motion_columns` (shared by
+``nmsm markers`` and the muscle analysis): no matching column is an error; absent
+coordinates, unknown columns and an implausible ``inDegrees`` header warn. A time range
+outside the motion is an error naming the file and both ranges (:func:`frames_in_range`).
 """
 
 from __future__ import annotations
@@ -26,28 +31,111 @@ from nmsm.model.external_loads import ExternalLoads, sample_loads
 from nmsm.model.signal import lowpass_iir, pad, quintic_spline, uniform_interval
 
 
-def motion_coordinates(model: Model, motion: Table) -> tuple[np.ndarray, list[str]]:
-    """Coordinate values ``(n, n_coordinates)`` in model order (file units) from a motion
-    table whose columns are coordinate names or state paths (``/jointset/j/c/value``),
-    and the names of coordinates absent from the file."""
+#: names listed in a message before "and N more"
+NAMED_COLUMNS = 5
+
+
+def _few(names: Sequence[str]) -> str:
+    """The first :data:`NAMED_COLUMNS` names, then 'and N more'."""
+    text = ", ".join(names[:NAMED_COLUMNS])
+    return text + (f" and {len(names) - NAMED_COLUMNS} more" if len(names) > NAMED_COLUMNS else "")
+
+
+def _coordinate_columns(motion: Table) -> dict[str, int]:
+    """Name -> column index of a motion whose labels are coordinate names or state paths
+    (``/jointset/j/c/value``: the name is ``c``); other state paths (``.../speed``,
+    ``/forceset/...``) name no coordinate and are left out."""
     by_name: dict[str, int] = {}
     for j, label in enumerate(motion.labels):
         name = label
         if label.startswith("/"):
             parts = label.strip("/").split("/")
-            if parts[-1] != "value":
+            if parts[-1] != "value" or len(parts) < 2:
                 continue
             name = parts[-2]
         by_name.setdefault(name, j)
+    return by_name
+
+
+def check_motion_columns(model: Model, motion: Table) -> list[str]:
+    """Match a motion's columns to the model's coordinates; returns the coordinates absent
+    from the motion (model order).
+
+    :class:`InputError` naming the file, the model and the expected coordinates when no
+    column names a coordinate; otherwise a warning listing the model's independent
+    coordinates absent from the motion (dependent coordinates of couplers are computed) and
+    the columns that name no model coordinate. The angle unit is checked against the model
+    (:func:`nmsm.io.motion_units.warn_implausible_angles`).
+    """
+    from nmsm.io.motion_units import warn_implausible_angles
+
+    by_name = _coordinate_columns(motion)
+    names = model.coordinate_names
+    known = set(names)
+    missing = [n for n in names if n not in by_name]
+    if len(missing) == len(names):
+        raise InputError(f"no column names a coordinate of the model {model.name} ({model.file})",
+                         file=motion.source, line=motion.label_line, element="column labels",
+                         expected=f"columns named after the model's coordinates: {_few(names)}")
+    unknown = [motion.labels[j] for n, j in by_name.items() if n not in known]
+    absent = [n for n in missing if n not in model.coupled_coordinates]
+    parts = []
+    if absent:
+        parts.append(f"coordinate(s) {_few(absent)} of the model {model.name} have no column (their default values "
+                     "are used)")
+    if unknown:
+        parts.append(f"column(s) {_few(unknown)} are not coordinates of the model (ignored)")
+    if parts:
+        warnings.warn(f"{motion.source or 'motion'}: " + "; ".join(parts), stacklevel=3)
+    rotational = {c.name: c.range for c in model.coordinates if c.motion_type == "rotational"}
+    warn_implausible_angles(motion, rotational, file=motion.source, stacklevel=4)
+    return missing
+
+
+def motion_coordinates(model: Model, motion: Table) -> tuple[np.ndarray, list[str]]:
+    """Coordinate values ``(n, n_coordinates)`` in model order (file units) from a motion
+    table whose columns are coordinate names or state paths (``/jointset/j/c/value``),
+    and the names of coordinates absent from the file (absent ones at their default values,
+    in degrees for rotational coordinates of a file in degrees).
+
+    The columns are checked against the model first (:func:`check_motion_columns`: an error
+    when none matches, a warning for absent coordinates, unknown columns or an implausible
+    angle unit).
+    """
+    missing = check_motion_columns(model, motion)
+    by_name = _coordinate_columns(motion)
     values = np.zeros((motion.n_rows, len(model.coordinates)))
-    missing = []
     for i, c in enumerate(model.coordinates):
         if c.name in by_name:
             values[:, i] = motion.data[:, by_name[c.name]]
+        elif motion.in_degrees and c.motion_type == "rotational":
+            values[:, i] = np.rad2deg(c.default_value)  # file units: callers convert every rotational column
         else:
-            missing.append(c.name)
             values[:, i] = c.default_value
     return values, missing
+
+
+def frames_in_range(times: np.ndarray, time_range: tuple[float, float] | None, source: object = None) -> np.ndarray:
+    """``(n,)`` True for the frames of ``times`` (s) within ``time_range`` (s, inclusive, to
+    1e-12 s; None: every frame; an infinite bound is open). :class:`InputError` naming
+    ``source``, the range asked and the range the file covers when a bound is not a number,
+    the range starts after it ends, or no frame lies in it."""
+    if time_range is None:
+        return np.ones(times.size, dtype=bool)
+    start, end = (float(b) for b in time_range)
+    asked = f"{start:g}-{end:g} s"
+    covers = f"the file covers {times[0]:g}-{times[-1]:g} s"
+    if np.isnan(start) or np.isnan(end):
+        raise InputError(f"the time range {asked} has a bound that is not a number ({covers})", file=source,
+                         element="time range", expected="numeric start and end times (s)")
+    if start > end:
+        raise InputError(f"the time range {asked} starts after it ends ({covers})", file=source,
+                         element="time range", expected="a start time no later than the end time")
+    keep = (times >= start - 1e-12) & (times <= end + 1e-12)
+    if not keep.any():
+        raise InputError(f"no frame lies in the time range {asked} ({covers})", file=source, element="time range",
+                         expected="a time range overlapping the motion")
+    return keep
 
 
 def generalized_force_labels(model: Model) -> list[str]:
@@ -70,17 +158,10 @@ def inverse_dynamics_of_motion(
     cm = casadi_model if casadi_model is not None else CasadiModel(model)
     values, missing = motion_coordinates(model, motion)
     coupled = model.coupled_coordinates
-    absent = [name for name in missing if name not in coupled]
-    if absent:
-        warnings.warn(f"{motion.source}: no column for coordinates {', '.join(absent)}; their default values are used",
-                      stacklevel=2)
     times = motion.time.copy()
     if times.size < 6:
         raise InputError(f"{times.size} rows are too few", file=motion.source, expected="at least 6 rows")
-    if time_range is None:
-        keep = np.ones(times.size, dtype=bool)
-    else:
-        keep = (times >= time_range[0] - 1e-12) & (times <= time_range[1] + 1e-12)
+    keep = frames_in_range(times, time_range, motion.source)
     out_times = times[keep]
     fit_times, fit_values = times, values
     if lowpass_hz is not None and lowpass_hz > 0:

@@ -86,36 +86,41 @@ class MuscleAnalysisResult:
 
     def write(self, directory: str | os.PathLike[str], trial: str) -> list[Path]:
         """Write ``<directory>/<trial>/<trial>_Length.sto``, ``_Velocity.sto`` and one
-        ``_MomentArm_<coord>.sto`` per coordinate; returns the paths."""
-        folder = Path(directory) / trial
+        ``_MomentArm_<coord>.sto`` per coordinate; returns the paths. ``trial`` must be a
+        plain file name (:func:`check_trial_name`)."""
+        folder = Path(directory) / check_trial_name(trial)
         folder.mkdir(parents=True, exist_ok=True)
         quantities = ["Length", "Velocity"] + [f"MomentArm_{c}" for c in self.coordinates]
         return [write_storage(folder / f"{trial}_{q}.sto", self.table(q), name=q) for q in quantities]
+
+
+def check_trial_name(trial: str) -> str:
+    """``trial`` when it is a plain file name (no path separator, not empty, ``.`` or ``..``),
+    so that files named after it stay in the output folder; else :class:`InputError`."""
+    separators = {"/", "\\", os.sep} | ({os.altsep} if os.altsep else set())
+    if not trial or trial.strip() in (".", "..") or any(s in trial for s in separators) or "\0" in trial:
+        raise InputError(f"trial name '{trial}' is not a plain file name: the files named after it would not stay "
+                         "in the output folder", element="trial",
+                         expected="a name without path separators, other than '.' and '..'")
+    return trial
 
 
 # ---- poses --------------------------------------------------------------------------------
 def motion_poses(model: Any, motion: Table) -> np.ndarray:
     """All model coordinates ``(n, n_q)`` (model order, rad/m) from a motion table.
 
-    ``model`` is a parsed :class:`~nmsm.model.components.Model`. Rotational columns are
-    converted when the file is in degrees; missing coordinates take default values;
-    dependent coordinates are set by their couplers.
+    ``model`` is a parsed :class:`~nmsm.model.components.Model`. The columns are matched to
+    the model's coordinates by :func:`nmsm.model.id_tool.motion_coordinates` (an error when
+    none matches; warnings for absent coordinates, unknown columns and an implausible angle
+    unit). Rotational columns are converted when the file is in degrees; missing coordinates
+    take default values; dependent coordinates are set by their couplers.
     """
-    names = model.coordinate_names
-    rotational = {c.name for c in model.coordinates if c.is_rotational}
-    table = motion.to_radians(rotational)
-    q = np.tile([c.default_value for c in model.coordinates], (table.n_rows, 1)).astype(float)
-    present = [n for n in names if table.has(n)]
-    if not present:
-        raise InputError(
-            "no column names a coordinate of the model",
-            file=motion.source,
-            line=motion.label_line,
-            element="column labels",
-            expected=f"coordinate names of {model.name} ({', '.join(names[:6])}, ...)",
-        )
-    for name in present:
-        q[:, names.index(name)] = table.column(name)
+    from nmsm.model.id_tool import motion_coordinates
+
+    q, _ = motion_coordinates(model, motion)
+    if motion.in_degrees:
+        rotational = [i for i, c in enumerate(model.coordinates) if c.is_rotational]
+        q[:, rotational] = np.deg2rad(q[:, rotational])
     if not model.coupled_coordinates:
         return q
     from nmsm.model.coordinates import CoordinateMap
@@ -154,7 +159,9 @@ def _opensim_geometry(model_file: Path, model: Any, q: np.ndarray, muscles: Sequ
         from nmsm.opensim_bridge import get_bridge
 
         bridge = get_bridge()
-    out = bridge.call("muscle_length_gradients", model=str(model_file), q=q, coordinates=model.coordinate_names,
+    # the worker runs in its own working folder: a relative path would not find the model there
+    out = bridge.call("muscle_length_gradients", model=str(Path(model_file).resolve()), q=q,
+                      coordinates=model.coordinate_names,
                       muscles=list(muscles), wrt=list(independent))
     return out["lengths"], out["gradient"]
 
@@ -168,6 +175,23 @@ def _nmsm_geometry(model: Any, q: np.ndarray, muscles: Sequence[str], independen
     geometry = MuscleGeometry(model, muscles, independent, surrogate=surrogate)
     lengths, _, arms = evaluate_function(geometry.function(), q)
     return lengths, -arms
+
+
+def check_model_names(kind: str, asked: Sequence[str], available: Sequence[str], model: str) -> None:
+    """:class:`InputError` naming the ``kind`` (``"muscles"``, ``"coordinates"``) among ``asked``
+    that are not in ``available``, the model (``model``: how to name it) and close matches."""
+    from nmsm.io.names import close_matches
+
+    pool = set(available)
+    unknown = [name for name in asked if name not in pool]
+    if not unknown:
+        return
+    described = []
+    for name in unknown:
+        close = close_matches(name, available, n=3)
+        described.append(f"'{name}'" + (f" (did you mean {' or '.join(close)}?)" if close else ""))
+    raise InputError(f"{kind} not in the model {model}: {', '.join(described)}", element=kind,
+                     expected=f"names of the model's {kind}")
 
 
 def _load_model(path: Path) -> Any:
@@ -204,13 +228,9 @@ def analyze_motion(
     table = motion if isinstance(motion, Table) else read_storage(motion)
     names = model.coordinate_names
     muscles = tuple(model.muscle_names if muscles is None else muscles)
-    for m in muscles:
-        model.muscle(m)  # KeyError naming the model when unknown
+    check_model_names("muscles", muscles, model.muscle_names, f"{model.name} ({model.file})")
     coords = tuple(names if coordinates is None else coordinates)
-    unknown = [c for c in coords if c not in names]
-    if unknown:
-        raise InputError(f"coordinates not in model {model.name}: {', '.join(unknown)}", element="coordinates",
-                         expected="model coordinate names")
+    check_model_names("coordinates", coords, names, f"{model.name} ({model.file})")
     dependents = model.coupled_coordinates
     independent = [n for n in names if n not in dependents]
 

@@ -92,6 +92,24 @@ def uniform_interval(times: np.ndarray, *, source: object = None) -> float:
     dt = float(np.min(steps))
     mean = (times[-1] - times[0]) / (len(times) - 1)
     if mean - dt > 1e-9 * max(1.0, abs(mean)) and (np.max(steps) - dt) > 1e-6 * dt:
-        raise InputError("low-pass filtering needs uniformly sampled data", file=source, element="time",
-                         expected="a constant time step")
+        raise InputError(f"low-pass filtering needs uniformly sampled data: {_step_changes(times, steps, dt)}",
+                         file=source, element="time", expected="a constant time step")
     return dt
+
+
+#: step changes named in the error of :func:`uniform_interval`
+NAMED_STEP_CHANGES = 3
+
+
+def _step_changes(times: np.ndarray, steps: np.ndarray, dt: float) -> str:
+    """Where the time step of ``times`` changes: the first :data:`NAMED_STEP_CHANGES` times
+    (s) with the step before and after, or the smallest and largest steps when it drifts."""
+    changes = np.flatnonzero(np.abs(np.diff(steps)) > 1e-6 * dt)
+    if changes.size == 0:
+        small, large = int(np.argmin(steps)), int(np.argmax(steps))
+        return (f"the time step drifts from {steps[small]:.6g} s (after t = {times[small]:.6g} s) to "
+                f"{steps[large]:.6g} s (after t = {times[large]:.6g} s)")
+    named = [f"t = {times[i + 1]:.6g} s ({steps[i]:.6g} s -> {steps[i + 1]:.6g} s)"
+             for i in changes[:NAMED_STEP_CHANGES]]
+    more = f" and {changes.size - NAMED_STEP_CHANGES} more" if changes.size > NAMED_STEP_CHANGES else ""
+    return "the time step changes at " + ", ".join(named) + more

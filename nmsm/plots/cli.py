@@ -95,12 +95,23 @@ def plot_tree(root: str | os.PathLike[str], output: str | os.PathLike[str] | Non
 
 
 def _plot(args: argparse.Namespace) -> int:
+    """``nmsm plot``: ``-o`` checked first (a folder, or a new one in an existing folder); the
+    folders it created and left empty (a results folder that failed) are removed again."""
     from nmsm.errors import InputError
+    from nmsm.io.output_file import check_output_folder, folders_below, remove_new_folders
 
     root = Path(args.results)
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
-    figures, errors = plot_tree(root, args.output)
+    output = None
+    if args.output:
+        output = check_output_folder(args.output, what="a folder for the figures (default: <each folder>/plots)")
+    before = folders_below(output) if output is not None else []
+    try:
+        figures, errors = plot_tree(root, output)
+    finally:
+        if output is not None:  # a folder drawn into is kept; one left empty by a failure is not
+            remove_new_folders(output, before)
     if not figures and not errors:
         print(f"nmsm: no results folder of JMP, MTP, NCP, GCP or treatment optimization in {root}", file=sys.stderr)
         return 1

@@ -130,7 +130,7 @@ def test_a_failed_write_leaves_the_earlier_file(
     def broken_fsync(fd: int) -> None:
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("nmsm.io.settings.output_file.os.fsync", broken_fsync)
+    monkeypatch.setattr("nmsm.io.output_file.os.fsync", broken_fsync)
     err = _fails(["upgrade-settings", "TorqueDrivenTOSettings.xml", "-o", "new.xml", "--force"], capsys)
     assert "new.xml: cannot write the output file: No space left on device" in err
     err = _fails(["print-xml", "solver", "-o", "new.xml", "--force"], capsys)

@@ -39,7 +39,7 @@ from nmsm.model.parameters import ModelParameters
 from nmsm.tools.jmp.dense_evaluator import DenseEvaluator
 from nmsm.tools.jmp.ik_settings import CoordinateTask, IkSettings, read_ik_settings
 from nmsm.tools.jmp.levenberg_marquardt import DenseJacobian, Tolerances, solve
-from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, select_trial
+from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, frames_in_range, select_trial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
 from nmsm.io.motion_units import warn_implausible_angles
 
@@ -175,7 +175,12 @@ def inverse_kinematics(
     if isinstance(markers, MarkerTrial):
         trial = markers
         if time_range is not None:
-            keep = (trial.time >= time_range[0] - 1e-9) & (trial.time <= time_range[1] + 1e-9)
+            keep = frames_in_range(trial.time, *time_range)
+            if not keep.any():
+                raise InputError(f"no frame of the marker trial lies in the time range {time_range[0]:g}-"
+                                 f"{time_range[1]:g} s (the trial covers {trial.time[0]:g}-{trial.time[-1]:g} s)",
+                                 file=trial.source, element="<time_range>",
+                                 expected="a time range overlapping the marker data")
             trial = attrs.evolve(trial, time=trial.time[keep], positions=trial.positions[keep])
     else:
         table = markers if isinstance(markers, MarkerTable) else read_trc(markers)

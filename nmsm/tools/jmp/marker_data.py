@@ -83,6 +83,7 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
         if not names:
             raise InputError("no marker of the marker file is a marker of the model", file=_where(table),
                              expected=f"marker names shared with {model.file}")
+        _warn_unmatched_markers(table, model, names)
         values = np.ones(len(names))
     else:
         names, values_list = [], []
@@ -107,8 +108,7 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
     positions = table.positions[:, index, :]
     if time_range is not None:
         start, end = time_range
-        tol = 1e-9 * max(1.0, abs(end))
-        keep = (time >= start - tol) & (time <= end + tol)
+        keep = frames_in_range(time, start, end)
         if not keep.any():
             raise InputError(f"no frame of the marker file lies in the time range {start:g}-{end:g} s "
                              f"(the file covers {time[0]:g}-{time[-1]:g} s)", file=settings_file or _where(table),
@@ -122,6 +122,44 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
                       "(weight 0 in every frame)", stacklevel=2)
     return MarkerTrial(time=np.array(time), names=tuple(names), positions=np.array(positions),
                        weights=values, source=_where(table))
+
+
+#: names listed in a warning before "and N more"
+NAMED_MARKERS = 5
+
+
+def _few(names: list[str]) -> str:
+    """The first :data:`NAMED_MARKERS` names, then 'and N more'."""
+    text = ", ".join(names[:NAMED_MARKERS])
+    return text + (f" and {len(names) - NAMED_MARKERS} more" if len(names) > NAMED_MARKERS else "")
+
+
+def _warn_unmatched_markers(table: MarkerTable, model: Model, used: list[str]) -> None:
+    """Warn when model markers are missing from the marker file (they are left out of the
+    fit), naming them and the file's markers that are not model markers."""
+    in_file = set(table.names)
+    missing = [n for n in model.marker_names if n not in in_file]
+    if not missing:
+        return
+    in_model = set(model.marker_names)
+    unknown = [n for n in table.names if n not in in_model]
+    text = (f"{_where(table)}: model marker(s) {_few(missing)} of {model.file} are not in the marker file; "
+            f"they are left out (the fit uses the other {len(used)})")
+    if unknown:
+        text += f"; the file's marker(s) {_few(unknown)} are not markers of the model"
+        hints = [f"{m} ~ {close[0]}" for m in missing if (close := close_matches(m, unknown, n=1))]
+        if hints:
+            text += f" (renamed? {', '.join(hints[:NAMED_MARKERS])})"
+    warnings.warn(text, stacklevel=3)
+
+
+def frames_in_range(time: np.ndarray, start: float, end: float) -> np.ndarray:
+    """``(F,)`` True for frames with ``start <= time <= end`` (s), to a round-off tolerance
+    (1e-9 of the larger finite bound, at least 1e-9 s); an infinite bound is open-ended and a
+    NaN bound selects nothing."""
+    finite = [abs(b) for b in (start, end) if math.isfinite(b)]
+    tol = 1e-9 * max([1.0, *finite])
+    return (time >= start - tol) & (time <= end + tol)
 
 
 def _warn_range_beyond_data(time: np.ndarray, start: float, end: float, keep: np.ndarray, source: str | None,

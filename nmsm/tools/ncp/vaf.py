@@ -9,6 +9,7 @@ several trials (``.sto`` files or folders of them) into one (samples, muscles) a
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -20,6 +21,12 @@ from nmsm.tools.ncp.nmf import nmf
 
 #: the thresholds the NMSM Pipeline recommends (fractions)
 DEFAULT_THRESHOLDS = (0.90, 0.95)
+#: activations (dimensionless, 0..1) at or above ``-NEGATIVE_TOLERANCE`` but below 0 are a
+#: solver's bound tolerance (NCP's combined activations reach -0.004): set to 0; lower ones
+#: are refused (NMF factors non-negative data)
+NEGATIVE_TOLERANCE = 0.01
+#: clipped values below ``-ROUND_OFF`` are reported in a warning
+ROUND_OFF = 1e-9
 
 
 @attrs.frozen
@@ -69,6 +76,12 @@ def vaf_curve(
     data = np.asarray(activations, dtype=float)
     if data.ndim != 2 or data.shape[1] == 0 or data.shape[0] == 0:
         raise ValueError(f"activations must be a non-empty (samples, muscles) array, got shape {data.shape}")
+    if np.any(data < -NEGATIVE_TOLERANCE):
+        i, j = np.argwhere(data < -NEGATIVE_TOLERANCE)[0]
+        raise InputError(f"activation {data[i, j]:g} at sample {i + 1}, muscle {j + 1} is negative",
+                         element="activations", expected=f"activations >= 0 (NMF; down to -{NEGATIVE_TOLERANCE:g} "
+                         "is taken for 0)")
+    data = np.maximum(data, 0.0)
     n_muscles = data.shape[1]
     top = min(n_muscles, 10) if max_synergies is None else min(int(max_synergies), n_muscles)
     if top < 1:
@@ -113,6 +126,48 @@ def read_activation_trials(
         table = read_storage(path)
         if names is None:
             names = table.labels
-        blocks.append(table.columns(list(names)))
+        blocks.append(non_negative(table.columns(list(names)), names, table.time, path, table.label_line))
     assert names is not None
     return np.vstack(blocks), names
+
+
+def _row_line(path: Path, label_line: int | None, row: int, time: float) -> int | None:
+    """The 1-based line of data row ``row`` (0-based) of the table file ``path`` whose labels
+    are on ``label_line``, when its time reads ``time`` (else None: rows were dropped)."""
+    if label_line is None:
+        return None
+    lines = path.read_text(errors="replace").splitlines()
+    seen = -1
+    for number in range(label_line + 1, len(lines) + 1):
+        tokens = lines[number - 1].split()
+        if not tokens:
+            continue
+        seen += 1
+        if seen == row:
+            try:
+                return number if abs(float(tokens[0]) - time) <= 1e-9 * max(1.0, abs(time)) else None
+            except ValueError:
+                return None
+    return None
+
+
+def non_negative(block: np.ndarray, names: Sequence[str], time: np.ndarray, path: Path,
+                 label_line: int | None = None) -> np.ndarray:
+    """``block`` ``(frames, muscles)`` of the file ``path`` with negatives down to
+    :data:`NEGATIVE_TOLERANCE` set to 0 (a warning names the file when one is below
+    -:data:`ROUND_OFF`); a lower value raises :class:`InputError` naming the file, its line
+    (``label_line``: the line of the column labels), data row, time and column."""
+    bad = np.argwhere(block < -NEGATIVE_TOLERANCE)
+    if bad.size:
+        i, j = bad[0]
+        more = f"; {len(bad) - 1} more value(s) below -{NEGATIVE_TOLERANCE:g}" if len(bad) > 1 else ""
+        raise InputError(f"negative activation {block[i, j]:g} in data row {i + 1} (time {time[i]:g} s){more}",
+                         file=path, line=_row_line(path, label_line, int(i), float(time[i])),
+                         element=f"column '{names[j]}'",
+                         expected=f"activations >= 0 (NMF factors non-negative data; down to -{NEGATIVE_TOLERANCE:g} "
+                         "is taken for 0)")
+    if block.size and block.min() < -ROUND_OFF:
+        i, j = np.unravel_index(int(np.argmin(block)), block.shape)
+        warnings.warn(f"{path}: {int(np.sum(block < 0))} slightly negative activation(s), the lowest "
+                      f"{block[i, j]:.3g} ('{names[j]}', time {time[i]:g} s), set to 0", stacklevel=3)
+    return np.maximum(block, 0.0)

@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 
@@ -32,30 +33,90 @@ def _example(args: argparse.Namespace) -> int:
     return 1 if args.strict and not outcome.all_within_tolerance else 0
 
 
+def _report_target(args: argparse.Namespace) -> tuple[Path, Path]:
+    """The results tree and the checked HTML file: never an existing non-HTML file of the tree."""
+    from nmsm.errors import InputError
+    from nmsm.io.output_file import check_outputs
+    from nmsm.report.html import REPORT_FILE
+
+    root = Path(args.results)
+    if not root.is_dir():
+        raise InputError("not a folder", file=root, expected="a results folder")
+    target = Path(args.output) if args.output else root / REPORT_FILE
+    html = target.suffix.lower() in (".html", ".htm")  # the report reads no HTML: an earlier report is replaced
+    folders = {} if html else {root: "the results tree being reported"}
+    option = "-o" if args.output else "the default report file"
+    check_outputs({option: target}, {}, protected_folders=folders, example_names={option: REPORT_FILE})
+    return root, target
+
+
 def _report(args: argparse.Namespace) -> int:
+    """``nmsm report``: the output checked, the page built and written atomically."""
+    from nmsm.io.output_file import write_atomically
     from nmsm.report.html import write_report
 
-    path = write_report(args.results, args.output)
-    print(f"wrote {path}")
+    root, target = _report_target(args)
+    write_atomically(target, lambda temporary: write_report(root, temporary))
+    print(f"wrote {target}")
     return 0
 
 
-def _export(args: argparse.Namespace) -> int:
+def _export_inputs(args: argparse.Namespace) -> tuple[dict[Path, str], dict[Path, str]]:
+    """Files and folders ``nmsm export`` reads (the .osimx, its model, the treatment folder)."""
+    from nmsm.interop.osim_export import associated_model
+    from nmsm.io.osimx import read_osimx
+
+    osimx = Path(args.osimx)
+    model = Path(args.model) if args.model else associated_model(osimx, read_osimx(osimx))
+    what = "the --model file" if args.model else "the model the .osimx names in <associated_osim_model>"
+    files = {osimx: "the input .osimx (OSIMX)", model: what}
+    folders = {Path(args.treatment): "the --treatment results folder"} if args.treatment else {}
+    return files, folders
+
+
+def _check_export(args: argparse.Namespace) -> tuple[Path | None, Path | None, Any]:
+    """Every argument, input and output of ``nmsm export`` before anything is written: the
+    .osim, the ExternalLoads XML and its .mot (none an input, none the same file), and the
+    treatment solution's ground reactions (read here). Returns (osim, loads xml, reactions)."""
     from nmsm.errors import InputError
-    from nmsm.interop.osim_export import export_osimx
+    from nmsm.io.output_file import check_outputs
 
-    if args.output:
-        report = export_osimx(args.osimx, args.output, model_path=args.model, include_contact=not args.no_contact)
-        print(report.text())
-    if args.treatment:
-        from nmsm.interop.treatment_loads import export_treatment_loads
-
-        if not args.loads:
-            raise InputError("--treatment needs --loads", element="nmsm export", expected="--loads LOADS.xml")
-        xml, data = export_treatment_loads(args.treatment, args.osimx, args.loads, args.trial)
-        print(f"wrote {xml} and {data}")
     if not args.output and not args.treatment:
         raise InputError("nothing to export", element="nmsm export", expected="-o MODEL.osim and/or --treatment DIR")
+    if args.treatment and not args.loads:
+        raise InputError("--treatment needs --loads", element="nmsm export", expected="--loads LOADS.xml")
+    if args.loads and not args.treatment:
+        raise InputError("--loads needs --treatment", element="nmsm export", expected="--treatment RESULTS_DIR")
+    files, folders = _export_inputs(args)
+    xml = Path(args.loads).with_suffix(".xml") if args.loads else None
+    data = xml.with_suffix(".mot") if xml else None
+    outputs = check_outputs({"-o": args.output, "--loads": xml, "--loads (its .mot)": data}, files,
+                            protected_folders=folders,
+                            example_names={"-o": "model.osim", "--loads": "loads.xml", "--loads (its .mot)": "loads.mot"})
+    reactions = None
+    if args.treatment:
+        from nmsm.interop.treatment_loads import solution_reactions
+
+        reactions = solution_reactions(Path(args.treatment), Path(args.osimx), args.trial)
+    return outputs.get("-o"), outputs.get("--loads"), reactions
+
+
+def _export(args: argparse.Namespace) -> int:
+    """``nmsm export``: everything checked first; the .osim written atomically, then the loads."""
+    import attrs
+
+    from nmsm.interop.external_loads import write_external_loads
+    from nmsm.interop.osim_export import export_osimx
+    from nmsm.io.output_file import write_atomically
+
+    osim, xml, reactions = _check_export(args)
+    if osim is not None:
+        report = write_atomically(osim, lambda temporary: export_osimx(
+            args.osimx, temporary, model_path=args.model, include_contact=not args.no_contact))
+        print(attrs.evolve(report, model=osim).text())
+    if xml is not None:
+        xml, data = write_external_loads(xml, reactions)
+        print(f"wrote {xml} and {data}")
     return 0
 
 

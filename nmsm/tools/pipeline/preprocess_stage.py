@@ -35,7 +35,6 @@ from nmsm.io.storage import Table
 from nmsm.tools.pipeline.native import read_native_settings
 from nmsm.tools.pipeline.preprocess_settings import TOOL, DataPreprocessingSettings, PreprocessTrial
 from nmsm.tools.preprocess.run import EmgOptions, process_emg_table
-from nmsm.tools.preprocess.signals import resample_with_gaps as _linear_with_gaps  # noqa: F401 (stage API)
 from nmsm.tools.preprocess.tables import read_table
 from nmsm.tools.preprocess.trials import TrialSources, split_into_trials
 

@@ -23,11 +23,62 @@ import math
 from pathlib import Path
 from typing import Any
 
+from nmsm.cli_types import fraction, non_negative_float, number, positive_float, positive_int
 from nmsm.errors import InputError
 
 
+def _check_arguments(args: argparse.Namespace) -> None:
+    """The argument combinations ``nmsm surrogate`` needs without a settings file."""
+    if not args.model or not args.coordinates or not args.output:
+        raise InputError("without a settings file, --model, --coordinates and --output are required",
+                         element="nmsm surrogate", expected="SETTINGS.xml, or --model M --coordinates ... --output F")
+    if bool(args.data_dir) == bool(args.motion):
+        raise InputError("give exactly one of --data-dir and --motion", element="nmsm surrogate",
+                         expected="a surrogate data folder or a reference motion")
+
+
+def _check_samples_folder(args: argparse.Namespace, inputs: dict[Path, str]) -> None:
+    """``--write-samples DIR``: a folder (created if its parent exists) whose files to be
+    written (``IKData/<trial>.sto``, ``MAData/<trial>/``) are none of the inputs."""
+    from nmsm.io.output_file import check_output_folder
+
+    folder = check_output_folder(args.write_samples, option="--write-samples",
+                                 what="a folder for the samples (IKData/, MAData/)").resolve()
+    trial = Path(args.motion).stem
+    written = (folder / "IKData" / f"{trial}.sto", folder / "MAData" / trial)
+    for path, what in inputs.items():
+        real = path.resolve()
+        if real == written[0] or real.is_relative_to(written[1]):
+            raise InputError(f"--write-samples would overwrite {what}", file=path,
+                             expected="another --write-samples folder than the one holding the inputs")
+
+
+def _check_outputs(args: argparse.Namespace, settings: Any) -> None:
+    """:class:`InputError` unless the surrogate file (and ``--write-samples``) may be written:
+    no input replaced, folders existing (nothing checked when the settings load an existing file)."""
+    from nmsm.io.output_file import check_outputs, existing_inputs
+
+    if settings is not None:
+        option, output = ("--output", Path(args.output)) if args.output else (
+            f"<surrogate_model_file_name> of {settings.settings_file}", settings.model_path)
+        if settings.load and output.is_file():
+            return  # load_surrogate_model: read, not written
+        inputs = existing_inputs({settings.settings_file: "the settings file (SETTINGS.xml)",
+                                  settings.model_file: "the model file the settings name in <input_model_file>"})
+        folders = {settings.data_directory: "the surrogate data folder the settings name"}
+    else:
+        _check_arguments(args)
+        option, output = "--output", Path(args.output)
+        inputs = existing_inputs({args.model: "the --model file", args.motion: "the --motion file"})
+        folders = {Path(args.data_dir): "the --data-dir folder"} if args.data_dir else {}
+        if args.write_samples and args.motion:
+            _check_samples_folder(args, inputs)
+    check_outputs({option: output}, inputs, protected_folders=folders, example_names={option: "surrogateMuscles.json"})
+
+
 def _fit(args: argparse.Namespace) -> tuple[Any, Path, bool]:
-    """The surrogate the arguments ask for, where it goes, and whether it is already there."""
+    """The surrogate the arguments ask for, where it goes, and whether it is written already
+    (a settings file that loads an existing surrogate). Every output is checked first."""
     import attrs
 
     from nmsm.io.storage import read_storage
@@ -35,21 +86,18 @@ def _fit(args: argparse.Namespace) -> tuple[Any, Path, bool]:
     from nmsm.tools.surrogate.settings import read_surrogate_settings
     from nmsm.tools.surrogate.tool import fit_from_data_directory, surrogate_from_settings
 
-    if args.settings:
-        settings = read_surrogate_settings(args.settings)
-        settings = attrs.evolve(settings, save=True)  # the command's purpose is the file
-        if args.output:
-            settings = attrs.evolve(settings, model_path=Path(args.output).resolve())
-        return surrogate_from_settings(settings), settings.model_path, True
-    if not args.model or not args.coordinates or not args.output:
-        raise InputError("without a settings file, --model, --coordinates and --output are required",
-                         element="nmsm surrogate", expected="SETTINGS.xml, or --model M --coordinates ... --output F")
-    if bool(args.data_dir) == bool(args.motion):
-        raise InputError("give exactly one of --data-dir and --motion", element="nmsm surrogate",
-                         expected="a surrogate data folder or a reference motion")
+    settings = read_surrogate_settings(args.settings) if args.settings else None
+    _check_outputs(args, settings)
+    if settings is not None:
+        # the command's purpose is the file: written by _surrogate (atomically) unless loaded
+        target = Path(args.output).resolve() if args.output else settings.model_path
+        settings = attrs.evolve(settings, save=False, model_path=target)
+        loaded = settings.load and target.is_file()
+        return surrogate_from_settings(settings), target, loaded
     if args.data_dir:
         model = fit_from_data_directory(args.model, args.data_dir, args.coordinates, degree=args.degree,
-                                        epsilon=args.epsilon, holdout_fraction=args.holdout, seed=args.seed)
+                                        epsilon=args.epsilon, holdout_fraction=args.holdout, seed=args.seed,
+                                        muscles=args.muscles)
         return model, Path(args.output), False
     from nmsm.tools.surrogate.sampling import opensim_samples, poses_around_motion
 
@@ -87,30 +135,55 @@ def _write_samples(folder: Path, trial: str, coords: tuple[str, ...], poses: Any
 
 
 def _surrogate(args: argparse.Namespace) -> int:
+    """``nmsm surrogate``: outputs checked, the surrogate fitted, its file written atomically."""
+    from nmsm.io.output_file import write_atomically
     from nmsm.tools.surrogate.tool import accuracy_report
 
     model, path, saved = _fit(args)
     if not saved:
-        model.save(path)
+        write_atomically(path, model.save)
     print(accuracy_report(model))
     print(f"surrogate of {len(model.muscles)} muscles, degree {model.degree}, written to {path}")
     return 0
 
 
+def _check_analysis_folder(args: argparse.Namespace, trial: str) -> Path:
+    """``-o``: a folder (created if its parent exists) whose ``<trial>/<trial>_*.sto`` files
+    are none of the inputs; returns it."""
+    from nmsm.io.output_file import check_output_folder, existing_inputs
+
+    folder = check_output_folder(args.output, option="-o",
+                                 what="the output folder: the files go in <output>/<trial>/")
+    trial_folder = folder / trial
+    if trial_folder.exists() and not trial_folder.is_dir():
+        raise InputError("the trial's output folder is a file", file=trial_folder,
+                         expected=f"a folder for {trial}_Length.sto, ... (or another --trial or -o)")
+    inputs = existing_inputs({args.model: "the input model (MODEL)", args.motion: "the input motion (MOTION)",
+                              args.surrogate: "the --surrogate file"})
+    for path, what in inputs.items():
+        real = path.resolve()
+        if real.parent == trial_folder.resolve() and real.name.startswith(f"{trial}_") and real.suffix == ".sto":
+            raise InputError(f"the output would overwrite {what}", file=path,
+                             expected="another -o folder or --trial than the ones holding the inputs")
+    return folder
+
+
 def _muscle_analysis(args: argparse.Namespace) -> int:
-    from nmsm.model.muscle_analysis import analyze_motion
+    """``nmsm muscle-analysis``: the output folder checked, the geometry computed, the files written."""
+    from nmsm.model.muscle_analysis import analyze_motion, check_trial_name
     from nmsm.model.surrogate import SurrogateModel
 
+    trial = check_trial_name(args.trial or Path(args.motion).stem)  # before any work
+    folder = _check_analysis_folder(args, trial)
     surrogate = SurrogateModel.load(args.surrogate) if args.surrogate else None
     result = analyze_motion(args.model, args.motion, muscles=args.muscles, coordinates=args.coordinates,
                             engine=args.engine, surrogate=surrogate, lowpass_hz=args.lowpass)
-    trial = args.trial or Path(args.motion).stem
-    paths = result.write(args.output, trial)
+    paths = result.write(folder, trial)
     counts: dict[str, int] = {}
     for source in result.sources.values():
         counts[source] = counts.get(source, 0) + 1
     how = ", ".join(f"{n} by {s}" for s, n in sorted(counts.items()))
-    print(f"{len(result.muscles)} muscles ({how}), {len(result.time)} frames: {len(paths)} files in {Path(args.output) / trial}")
+    print(f"{len(result.muscles)} muscles ({how}), {len(result.time)} frames: {len(paths)} files in {folder / trial}")
     return 0
 
 
@@ -123,13 +196,19 @@ def register(subparsers: Any) -> None:
     p.add_argument("--motion", help="reference motion to sample poses around (OpenSim computes the geometry)")
     p.add_argument("--coordinates", nargs="+", help="surrogate coordinate list")
     p.add_argument("--muscles", nargs="+", help="muscles to fit (default: all)")
-    p.add_argument("--degree", type=int, default=5, help="polynomial degree (default 5)")
-    p.add_argument("--epsilon", type=float, default=1e-4, help="moment arm (m) above which a coordinate counts (1e-4)")
-    p.add_argument("--holdout", type=float, default=0.2, help="share of poses held out to measure accuracy (0.2)")
+    p.add_argument("--degree", type=number(0, integer=True, name="degree"), default=5,
+                   help="polynomial degree (>= 0, default 5)")
+    p.add_argument("--epsilon", type=non_negative_float, default=1e-4,
+                   help="moment arm (m, >= 0) above which a coordinate counts (1e-4)")
+    p.add_argument("--holdout", type=fraction, default=0.2,
+                   help="share of poses held out to measure accuracy (in [0, 1), default 0.2)")
     p.add_argument("--seed", type=int, default=0, help="random seed for sampling and the hold-out split")
-    p.add_argument("--samples-per-frame", type=int, default=25, help="Latin-hypercube poses per motion frame (25)")
-    p.add_argument("--angular-padding", type=float, default=10.0, help="sampling half-width of rotations, degrees (10)")
-    p.add_argument("--linear-padding", type=float, default=0.0, help="sampling half-width of translations, m (0)")
+    p.add_argument("--samples-per-frame", type=positive_int, default=25,
+                   help="Latin-hypercube poses per motion frame (>= 1, default 25)")
+    p.add_argument("--angular-padding", type=non_negative_float, default=10.0,
+                   help="sampling half-width of rotations, degrees (>= 0, default 10)")
+    p.add_argument("--linear-padding", type=non_negative_float, default=0.0,
+                   help="sampling half-width of translations, m (>= 0, default 0)")
     p.add_argument("--vary-all", action="store_true",
                    help="with --motion: vary every coordinate of the motion (the original), not only --coordinates")
     p.add_argument("--moment-arms", choices=["derivative", "opensim"], default="derivative",
@@ -149,6 +228,6 @@ def register(subparsers: Any) -> None:
     p.add_argument("--engine", choices=["auto", "nmsm", "opensim"], default="auto",
                    help="auto: exact paths, OpenSim (or --surrogate) for wrapping muscles")
     p.add_argument("--surrogate", help="surrogate model (.json) for wrapping muscles")
-    p.add_argument("--lowpass", type=float, default=None,
-                   help="low-pass cut-off (Hz) for the coordinates, as OpenSim's AnalyzeTool (default: none)")
+    p.add_argument("--lowpass", type=positive_float, default=None,
+                   help="low-pass cut-off (Hz, > 0) for the coordinates, as OpenSim's AnalyzeTool (default: none)")
     p.set_defaults(func=_muscle_analysis)

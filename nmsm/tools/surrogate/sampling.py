@@ -109,10 +109,15 @@ def opensim_samples(
     if moment_arms not in MOMENT_ARM_KINDS:
         raise InputError(f"unknown moment-arm kind '{moment_arms}'", element="moment_arms",
                          expected=" or ".join(MOMENT_ARM_KINDS))
+    from nmsm.model.muscle_analysis import check_model_names
+
     bridge = _bridge(bridge)
     path = str(Path(model_file).resolve())
+    info = model_geometry_info(path, bridge)
+    check_model_names("coordinates", surrogate_coordinates, info["coordinates"], str(model_file))
     if muscles is None:
-        muscles = model_geometry_info(path, bridge)["muscles"]
+        muscles = info["muscles"]
+    check_model_names("muscles", muscles, info["muscles"], str(model_file))
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
     kw = dict(model=path, q=poses, coordinates=list(pose_coordinates), muscles=list(muscles))
     if moment_arms == "derivative":
@@ -122,6 +127,6 @@ def opensim_samples(
         lengths = bridge.call("muscle_lengths", **kw)
         arms = bridge.call("muscle_moment_arms", moment_arm_coordinates=list(surrogate_coordinates), **kw)
     full = bridge.call("coupled_poses", model=path, q=poses, coordinates=list(pose_coordinates))
-    names = model_geometry_info(path, bridge)["coordinates"]
+    names = info["coordinates"]
     q = full[:, [names.index(c) for c in surrogate_coordinates]]
     return GeometrySamples(tuple(surrogate_coordinates), tuple(muscles), q, lengths, arms)

@@ -42,8 +42,22 @@ def fit_from_data_directory(
     holdout_fraction: float = HOLDOUT_FRACTION,
     seed: int | None = 0,
 ) -> SurrogateModel:
-    """Fit a surrogate to the samples of a surrogate data folder (IKData + MAData)."""
-    samples = read_samples(data_directory, coordinates, rotational_coordinates(model_file), trials, muscles)
+    """Fit a surrogate to the samples of a surrogate data folder (IKData + MAData).
+
+    ``coordinates`` and ``muscles`` (default: every muscle of the Length files) are checked
+    against the model first: :class:`InputError` naming the unknown names, the model and
+    close matches.
+    """
+    from nmsm.model import load_model
+    from nmsm.model.muscle_analysis import check_model_names
+
+    model = load_model(model_file)
+    described = f"{model.name} ({model_file})"
+    check_model_names("coordinates", coordinates, model.coordinate_names, described)
+    if muscles is not None:
+        check_model_names("muscles", muscles, model.muscle_names, described)
+    rotational = {c.name for c in model.coordinates if c.is_rotational}
+    samples = read_samples(data_directory, coordinates, rotational, trials, muscles)
     meta = {"model_file": str(Path(model_file).resolve()), "data_directory": str(Path(data_directory).resolve()),
             "moment_arms": "MuscleAnalysis files"}
     return fit_surrogate_model(samples, degree, epsilon, holdout_fraction=holdout_fraction, seed=seed, metadata=meta)

@@ -13,9 +13,10 @@ from nmsm.io.storage import Table
 from nmsm.tools.dispatch import tool_element_name
 from nmsm.tools.pipeline.analysis import measured_moments
 from nmsm.tools.pipeline.analysis import read_settings as read_analysis
-from nmsm.tools.pipeline.preprocess_stage import _linear_with_gaps, process_emg
+from nmsm.tools.pipeline.preprocess_stage import process_emg
 from nmsm.tools.pipeline.preprocess_stage import read_settings as read_preprocess
 from nmsm.tools.pipeline.preprocess_stage import run_settings as run_preprocess
+from nmsm.tools.preprocess.signals import resample_with_gaps
 
 
 def _write(path: Path, tool: str) -> Path:
@@ -98,7 +99,7 @@ def test_emg_envelope_recovers_a_modulated_excitation() -> None:
 def test_center_of_pressure_gaps_resample_without_mixing() -> None:
     time = np.linspace(0, 1, 11)
     point = np.where(time < 0.45, np.nan, 0.3 + 0.1 * time)
-    out = _linear_with_gaps(time, point[:, None], np.array([0.1, 0.42, 0.47, 0.55, 0.95]))[:, 0]
+    out = resample_with_gaps(time, point[:, None], np.array([0.1, 0.42, 0.47, 0.55, 0.95]))[:, 0]
     assert np.isnan(out[0])  # between two gap samples
     assert out[1] == pytest.approx(0.35) and out[2] == pytest.approx(0.35)  # gap edge: the valid neighbour
     assert out[3] == pytest.approx(0.3 + 0.1 * 0.55)

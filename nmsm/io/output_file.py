@@ -1,0 +1,244 @@
+"""Output paths of the ``nmsm`` commands: checked before anything is computed, written atomically.
+
+Before anything is written (:func:`check_output`, :func:`check_output_folder`):
+
+* the output's folder must exist: no command creates missing folders above the file or
+  folder it was told to write (a typo in a path must not make folders);
+* an output file must not name a folder, an output folder must not name a file;
+* *protected* files are never replaced: every input of the command (and, for
+  ``print-xml``/``upgrade-settings``, every file the settings name). They are compared by
+  identity (:func:`os.path.samefile`: the same inode), so another spelling, a symbolic link
+  or a hard link of an input is refused too; an existing file inside a *protected folder*
+  (a data folder the command reads) is refused as well;
+* an existing file that is none of these is replaced only with ``force`` (``print-xml`` and
+  ``upgrade-settings`` ask for ``--force``; the other commands replace their earlier output).
+
+:func:`write_output` (text) and :func:`write_atomically` (any writer) write into a temporary
+file in the output's folder and move it into place with :func:`os.replace`, so a failure
+leaves the earlier file (or none), never a half-written one.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import tempfile
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+from typing import TypeVar
+
+from nmsm.errors import InputError
+
+#: how the messages name the option, unless told otherwise
+OPTION = "-o"
+_T = TypeVar("_T")
+
+
+def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    """Whether ``a`` and ``b`` are one file (same inode) or, when one does not exist, spell the same path."""
+    a, b = Path(a), Path(b)
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.abspath(a) == os.path.abspath(b) or a.resolve() == b.resolve()
+
+
+_same_file = same_file  # the name nmsm.io.settings.output_file used
+
+
+def _check_parent(path: Path, option: str, kind: str) -> None:
+    """:class:`InputError` when the folder ``path`` would go in is missing or is a file."""
+    folder = path.parent
+    if not folder.exists():
+        raise InputError(
+            f"cannot write the output {kind}: its folder {folder} does not exist",
+            file=path,
+            expected=f"{option} naming a {kind} in an existing folder: create {folder} first or fix the path",
+        )
+    if not folder.is_dir():
+        raise InputError(
+            f"cannot write the output {kind}: {folder} is a file, not a folder",
+            file=path,
+            expected=f"{option} naming a {kind} in an existing folder",
+        )
+
+
+def check_output(
+    path: str | os.PathLike[str],
+    *,
+    force: bool = False,
+    protected: Mapping[Path, str] | None = None,
+    protected_folders: Mapping[Path, str] | None = None,
+    example_name: str = "NEW.xml",
+    option: str = OPTION,
+    force_option: bool = True,
+    name_option: bool = False,
+) -> Path:
+    """``path`` as a :class:`Path` when it may be written, else :class:`InputError`.
+
+    ``protected``: files never replaced -> what each is (for the message, e.g. "the solver
+    settings file that OLD.xml names in <optimal_control_settings_file> (line 14)");
+    ``protected_folders``: folders whose existing files are never replaced -> what each is.
+    ``example_name``: a file name suggested when ``path`` is a folder; ``option``: how the
+    messages name the option (``-o``, ``--errors``, ...); ``force_option``: whether the
+    command has ``--force`` (the messages then say it never replaces an input);
+    ``name_option``: an input refused is reported as "the output file (OPTION) is ...".
+    """
+    path = Path(path)
+    never = "another output file name" + ("; --force never replaces an input" if force_option else "")
+    if path.is_dir():
+        raise InputError(
+            f"{option} names a folder, not a file",
+            file=path,
+            expected=f"the name of the file to write, e.g. {path / example_name}",
+        )
+    _check_parent(path, option, "file")
+    named = f"the output file ({option})" if name_option else "the output file"
+    for other, what in (protected or {}).items():
+        if same_file(path, Path(other)):
+            raise InputError(f"{named} is {what}: writing it would overwrite an input", file=path, expected=never)
+    exists = path.exists() or path.is_symlink()
+    if exists:
+        real = path.resolve()
+        for inputs, what in (protected_folders or {}).items():
+            if real.is_relative_to(Path(inputs).resolve()):
+                raise InputError(
+                    f"{named} already exists inside {what} ({inputs}): writing it would overwrite an input",
+                    file=path,
+                    expected=never,
+                )
+        if not force:
+            raise InputError(
+                "the output file already exists",
+                file=path,
+                expected="a new file name, or --force to replace it",
+            )
+    return path
+
+
+def check_outputs(
+    outputs: Mapping[str, str | os.PathLike[str] | None],
+    inputs: Mapping[Path, str],
+    *,
+    protected_folders: Mapping[Path, str] | None = None,
+    example_names: Mapping[str, str] | None = None,
+) -> dict[str, Path]:
+    """Check every output file of a command before it computes anything.
+
+    ``outputs``: option (``-o``, ``--errors``) -> path (None: not written); ``inputs``: the
+    command's input files -> what each is (they are never replaced). Existing files that are
+    no input are replaced (the commands rewrite their earlier output). Two options naming one
+    file are refused too. Returns option -> :class:`Path` of the outputs given.
+    """
+    checked: dict[str, Path] = {}
+    for option, raw in outputs.items():
+        if raw is None:
+            continue
+        path = check_output(raw, force=True, protected=inputs, protected_folders=protected_folders,
+                            example_name=(example_names or {}).get(option, "OUTPUT"), option=option,
+                            force_option=False, name_option=True)
+        for other, earlier in checked.items():
+            if same_file(path, earlier):
+                raise InputError(f"{option} and {other} name the same file", file=path,
+                                 expected=f"a different file for {option} and {other}")
+        checked[option] = path
+    return checked
+
+
+def check_output_folder(
+    path: str | os.PathLike[str],
+    *,
+    option: str = OPTION,
+    what: str = "the output folder",
+) -> Path:
+    """``path`` as a :class:`Path` when it may be used as an output folder (an existing folder,
+    or a new one whose parent exists: it is created when written), else :class:`InputError`."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} names a file, not a folder", file=path, expected=what)
+    if not path.exists():
+        _check_parent(path, option, "folder")
+    return path
+
+
+def existing_inputs(paths: Mapping[str | os.PathLike[str] | None, str]) -> dict[Path, str]:
+    """``paths`` without the ``None`` keys, as :class:`Path` -> what each is."""
+    return {Path(p): what for p, what in paths.items() if p is not None}
+
+
+def _temporary(path: Path) -> Path:
+    """A new empty file next to ``path`` with the same suffix (writers may go by it)."""
+    try:
+        handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent)
+    except OSError as exc:
+        raise InputError(
+            f"cannot write the output file: {exc.strerror or exc}", file=path, expected="a writable folder"
+        ) from None
+    os.close(handle)
+    return Path(name)
+
+
+def _mode_for(path: Path) -> int:
+    """The permission bits of ``path`` when it exists, else those a new file gets (umask)."""
+    if path.is_file():
+        return stat.S_IMODE(path.stat().st_mode)
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _flush_to_disk(path: Path) -> None:
+    """Make the written bytes of ``path`` durable before it replaces anything (a full disk fails here)."""
+    handle = os.open(path, os.O_RDWR)  # Windows commits only handles open for writing
+    try:
+        os.fsync(handle)
+    finally:
+        os.close(handle)
+
+
+def write_atomically(path: str | os.PathLike[str], write: Callable[[Path], _T]) -> _T:
+    """Call ``write(temporary)`` with a temporary file in ``path``'s folder, then move it onto
+    ``path`` (:func:`os.replace`); returns what ``write`` returned. On any failure the
+    temporary file is removed and ``path`` is left as it was. An :class:`OSError` becomes an
+    :class:`InputError` naming ``path``."""
+    path = Path(path)
+    temporary = _temporary(path)
+    try:
+        result = write(temporary)
+        _flush_to_disk(temporary)
+        os.chmod(temporary, _mode_for(path))
+        os.replace(temporary, path)
+        return result
+    except BaseException as exc:
+        temporary.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise InputError(
+                f"cannot write the output file: {exc.strerror or exc}", file=path, expected="a writable folder"
+            ) from None
+        raise
+
+
+def write_output(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically (see module docstring); an
+    :class:`InputError` naming ``path`` when the folder is not writable."""
+    write_atomically(path, lambda temporary: temporary.write_text(text, encoding="utf-8"))
+
+
+def remove_new_folders(root: Path, existing: Iterable[Path]) -> None:
+    """Remove the empty folders at and below ``root`` that are not in ``existing`` (folders
+    a failed command created and left empty); folders holding files are kept."""
+    before = {Path(p).resolve() for p in existing}
+    if not root.is_dir():
+        return
+    for folder, _, _ in sorted(os.walk(root), key=lambda entry: -len(Path(entry[0]).parts)):
+        path = Path(folder)
+        if path.resolve() not in before and not any(path.iterdir()):
+            try:
+                path.rmdir()
+            except OSError:
+                pass
+
+
+def folders_below(root: Path) -> list[Path]:
+    """``root`` (when it exists) and every folder below it."""
+    return [Path(folder) for folder, _, _ in os.walk(root)] if root.is_dir() else []
