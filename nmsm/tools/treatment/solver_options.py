@@ -41,7 +41,8 @@ class SolverPlan:
 
 def plan_from_settings(gpops: Any, *, source: str = "") -> SolverPlan:
     """Mesh and IPOPT options of a :class:`nmsm.io.settings.solver.GpopsSettings`; warns
-    once about options that do not apply (see module docstring)."""
+    once about options set away from their defaults that do not apply (see module docstring;
+    a file that leaves them at their defaults gets no warning)."""
     mesh = Mesh.uniform(int(gpops.setup_mesh_phase_intervals), int(gpops.setup_mesh_phase_colpoints_per_Interval))
     display = int(gpops.setup_display_level)
     where = f"{source}: " if source else ""
@@ -56,15 +57,18 @@ def plan_from_settings(gpops: Any, *, source: str = "") -> SolverPlan:
         "linear_solver": str(gpops.setup_nlp_linear_solver),
         "print_level": 0 if display == 0 else (3 if display == 1 else 5),
     }
-    ignored = [
-        f"setup_derivatives_supplier={gpops.setup_derivatives_supplier} (derivatives are exact, from CasADi)",
-        f"integral_bound={gpops.integral_bound} (cost integrals are not bounded)",
-    ]
+    ignored = []  # options set away from their defaults that nmsm cannot honour
+    if gpops.setup_derivatives_supplier != "sparseFD":
+        ignored.append(f"setup_derivatives_supplier={gpops.setup_derivatives_supplier} (derivatives are exact, "
+                       "from CasADi)")
+    if float(gpops.integral_bound) != 1.0:
+        ignored.append(f"integral_bound={gpops.integral_bound} (cost integrals are not bounded)")
     if gpops.setup_scales_method != "none":
         ignored.append(f"setup_scales_method={gpops.setup_scales_method} (variables are scaled by their bounds)")
     if gpops.setup_mesh_method != "none" and int(gpops.setup_mesh_max_iterations) > 0:
         ignored.append(f"setup_mesh_method={gpops.setup_mesh_method} (no mesh refinement: the initial mesh is used)")
     if gpops.setup_nlp_solver != "ipopt":
         ignored.append(f"setup_nlp_solver={gpops.setup_nlp_solver} (IPOPT is used)")
-    warnings.warn(where + "GPOPS-II options without effect in nmsm: " + "; ".join(ignored), stacklevel=2)
+    if ignored:
+        warnings.warn(where + "GPOPS-II options without effect in nmsm: " + "; ".join(ignored), stacklevel=2)
     return SolverPlan(mesh, ipopt, tuple(ignored))

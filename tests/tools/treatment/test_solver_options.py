@@ -1,0 +1,30 @@
+"""GPOPS-II solver settings: options without effect in nmsm warn only when a file sets them."""
+
+from __future__ import annotations
+
+import warnings
+
+import attrs
+import pytest
+
+from nmsm.io.settings.solver import GpopsSettings
+from nmsm.tools.treatment.solver_options import plan_from_settings
+
+
+def test_options_left_at_their_defaults_give_no_warning() -> None:
+    """(The default mesh method refines the mesh in GPOPS-II, which nmsm does not: that one
+    warns at its default; the example's and tutorials' files set it to none.)"""
+    gpops = attrs.evolve(GpopsSettings(), setup_mesh_method="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plan = plan_from_settings(gpops, source="solver.xml")
+    assert plan.not_applicable == ()
+
+
+def test_options_set_away_from_their_defaults_are_named_once() -> None:
+    gpops = attrs.evolve(GpopsSettings(), setup_mesh_method="none", setup_derivatives_supplier="adigator",
+                         integral_bound=10.0)
+    with pytest.warns(UserWarning, match=r"solver.xml: GPOPS-II options without effect in nmsm: "
+                                         r"setup_derivatives_supplier=adigator .*; integral_bound=10.0") as caught:
+        plan = plan_from_settings(gpops, source="solver.xml")
+    assert len(caught) == 1 and len(plan.not_applicable) == 2
