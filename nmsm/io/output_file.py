@@ -43,8 +43,6 @@ def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
         return os.path.abspath(a) == os.path.abspath(b) or a.resolve() == b.resolve()
 
 
-_same_file = same_file  # the name nmsm.io.settings.output_file used
-
 
 def _check_parent(path: Path, option: str, kind: str) -> None:
     """:class:`InputError` when the folder ``path`` would go in is missing or is a file."""

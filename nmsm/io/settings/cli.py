@@ -3,7 +3,7 @@
 
 ``-o`` must name a file in an existing folder; an existing file is replaced only with
 ``--force``; ``upgrade-settings`` never writes over the old file or a file it names, and both
-write atomically (:mod:`nmsm.io.settings.output_file`).
+write atomically (:mod:`nmsm.io.output_file`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ TOOL_CODES = {code: element for element, code in TOOL_ELEMENTS.items()}
 
 
 def _print_xml(args: argparse.Namespace) -> int:
-    from nmsm.io.settings.output_file import check_output, write_output
+    from nmsm.io.output_file import check_output, write_output
     from nmsm.io.settings.template import format_template
 
     text = format_template(TOOL_CODES[args.tool])

@@ -268,10 +268,10 @@ def upgrade_settings_file(
     any spelling or link form) or a file ``source`` names (its solver settings, model, data),
     or an existing file inside a data folder it names; an existing ``destination`` without
     ``force``; a missing folder; a folder. The file is written atomically
-    (:mod:`nmsm.io.settings.output_file`).
+    (:mod:`nmsm.io.output_file`).
     """
     from nmsm.io.settings.document import parse_settings_xml
-    from nmsm.io.settings.output_file import check_output, write_output
+    from nmsm.io.output_file import check_output, write_output
 
     source, destination = Path(source), Path(destination)
     itself = {source: "the settings file being upgraded (this name, a link or another spelling of it)"}
