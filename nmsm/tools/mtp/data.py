@@ -14,8 +14,9 @@ moment arms ``(n_frames, n_coordinates, n_muscles)`` (m), moments
 
 from __future__ import annotations
 
+import contextlib
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import attrs
@@ -116,7 +117,8 @@ def load_trial(
     id_table = read_storage(id_path)
     moments = np.column_stack([id_table.load_column(c) for c in coordinates]) if coordinates else np.zeros((id_table.n_rows, 0))
     ma_root = Path(ma_directory) if ma_directory is not None else root / "MAData"
-    folder = find_trial_folder(ma_root, prefix)
+    with _trial_origin(prefix, root):
+        folder = find_trial_folder(ma_root, prefix)
     length = read_storage(find_file_by_suffix(folder, "_Length"))
     velocity = read_storage(find_file_by_suffix(folder, "_Velocity"))
     lmt = _columns(length, muscles, "muscle-tendon length file")
@@ -135,7 +137,8 @@ def load_trial(
     emg_time = emg = None
     padding = 0
     if emg_channels is not None:
-        emg_path = find_trial_file(root / "EMGData", prefix)
+        with _trial_origin(prefix, root):
+            emg_path = find_trial_file(root / "EMGData", prefix)
         emg_table = read_storage(emg_path)
         emg = _columns(emg_table, emg_channels, "EMG file")
         emg_time = emg_table.time
@@ -151,6 +154,19 @@ def load_trial(
         emg=emg,
         padding=padding,
     )
+
+
+@contextlib.contextmanager
+def _trial_origin(prefix: str, root: Path) -> Iterator[None]:
+    """Say where a trial name came from when another folder has nothing for it (a renamed
+    IDData file shows up as a trial the other folders lack)."""
+    try:
+        yield
+    except InputError as exc:
+        note = (f"; trial '{prefix}' is a file name of {root / 'IDData'} (the trials are those files unless "
+                "<trial_prefixes> lists them)")
+        raise InputError(exc.detail + note, file=exc.file, line=exc.line, element=exc.element,
+                         expected=exc.expected) from exc
 
 
 def find_prefixes(data_directory: str | os.PathLike[str], requested: Sequence[str] = ()) -> list[str]:

@@ -96,6 +96,15 @@ def test_missing_moment_arm_file(case) -> None:
         run_settings(case.settings_file, print_level=0)
 
 
+def test_renamed_inverse_dynamics_file_is_named_as_the_trial_s_origin(case) -> None:
+    """A renamed IDData file becomes a trial the other folders lack: the error says where the trial came from."""
+    ident = case.folder / "data" / "IDData"
+    (ident / "trial_2.sto").rename(ident / "trial_7.sto")
+    with pytest.raises(InputError, match=r"no folder for trial 'trial_7' .*; trial 'trial_7' is a file name of "
+                                         r".*IDData \(the trials are those files unless <trial_prefixes> lists them\)"):
+        run_settings(case.settings_file, print_level=0)
+
+
 def test_results_next_to_the_settings_keep_the_settings_file(case) -> None:
     before = case.settings_file.read_bytes()
     run = run_settings(case.settings_file, results_directory=case.folder, print_level=0)
