@@ -43,6 +43,7 @@ last iterate), that stays and the earlier results move into its ``superseded/``.
 from __future__ import annotations
 
 import datetime
+import inspect
 import os
 import shutil
 import time
@@ -157,6 +158,24 @@ def _selection(spec: PipelineSpec, only: Sequence[str] | None, until: str | None
     return selected
 
 
+def _check_stage_options(spec: PipelineSpec, stage_options: dict[str, dict[str, Any]]) -> None:
+    """Refuse, before anything runs, ``stage_options`` for a stage the pipeline does not have
+    or naming an option its tool's ``run_settings`` does not take."""
+    stages = {s.name: s for s in spec.stages}
+    for name, options in stage_options.items():
+        if name not in stages:
+            raise InputError(f"stage_options for '{name}', which is not a stage of the pipeline", file=spec.file,
+                             expected="stage names: " + ", ".join(stages))
+        parameters = inspect.signature(stages[name].kind.load_run()).parameters.values()
+        if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters):
+            continue
+        known = [p.name for p in parameters if p.kind is inspect.Parameter.KEYWORD_ONLY]
+        unknown = [key for key in options if key not in known]
+        if unknown:
+            raise InputError(f"stage_options of stage '{name}': unknown option(s) {', '.join(unknown)}",
+                             file=spec.file, expected="options of its tool: " + ", ".join(known))
+
+
 def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until: str | None = None,
                  rebuild: bool = False, force: Iterable[str] = (), check_only: bool = False,
                  log: Callable[[str], None] | None = print, stage_options: dict[str, dict[str, Any]] | None = None,
@@ -172,7 +191,10 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     """
     say = log or (lambda text: None)
     start = time.perf_counter()
+    only = (only,) if isinstance(only, str) else only  # one stage name given as a string
+    force = (force,) if isinstance(force, str) else force
     _check_names(spec)
+    _check_stage_options(spec, stage_options or {})
     check_order(spec)
     results = spec.results_directory
     _check_results_location(spec)

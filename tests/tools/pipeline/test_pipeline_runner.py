@@ -407,3 +407,15 @@ def test_rebuild_on_an_unreadable_state_never_empties_an_unmarked_folder(case: P
     assert f"its results folder {results / 'fit'} already exists and was not written by this pipeline" in text
     assert "is damaged (unreadable pipeline state" in text and f"holds no {MARKER} marker" in text
     assert _tree(results) == before and CALLS == []
+
+
+def test_one_stage_name_as_a_string_and_stage_options_checked_first(case: Path) -> None:
+    pipeline = _pipeline(case)
+    run = run_pipeline_file(pipeline, only="make", log=None)  # not the letters m, a, k, e
+    assert _statuses(run) == {"make": RAN, "fit": "not selected"}
+    CALLS.clear()
+    with pytest.raises(InputError, match=r"stage_options for 'fitt', which is not a stage of the pipeline "
+                                         r"\(expected stage names: make, fit\)"):
+        run_pipeline_file(pipeline, stage_options={"fitt": {}}, log=None)
+    assert CALLS == []
+
