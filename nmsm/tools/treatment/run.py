@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import attrs
+import numpy as np
 
 from nmsm.core.problem import Solution
 from nmsm.core.results import SUPERSEDED, ResultsDirectory
@@ -232,6 +233,16 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
             shutil.rmtree(log_dir, ignore_errors=True)
 
 
+def _not_finite(solution: Solution) -> str:
+    """``; not finite at the last iterate: ...`` naming the cost terms and constraint blocks
+    whose value is NaN or infinite there (a term's bug or a pose outside its domain), else ``""``."""
+    names = [name for name, value in solution.term_costs.items() if not np.isfinite(value)]
+    names += [c.name for c in solution.constraints if not np.isfinite(c.max_violation)]
+    if not names:
+        return ""
+    return f"; not finite at the last iterate: {', '.join(names[:6])}" + (" ..." if len(names) > 6 else "")
+
+
 def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prepared, opts: TreatmentOptions,
                      results: ResultsDirectory | None, log_dir: Path | None, initial_cost: float,
                      build_time: float) -> TreatmentRun:
@@ -259,7 +270,7 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
                     shutil.copy2(log, target / log.name)
             saved = str(Path(results.path) / "last_iterate")
         raise SolverError(f"{settings.settings_file}: IPOPT did not converge ({solution.status} after "
-                          f"{solution.iterations} iterations){note}", last_iterate_path=saved)
+                          f"{solution.iterations} iterations){_not_finite(solution)}{note}", last_iterate_path=saved)
     if results is not None:
         from nmsm.tools.treatment.design import parameter_tables, write_parameter_solution
         from nmsm.tools.treatment.outputs import write_solution
