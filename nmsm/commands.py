@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import io
+import os
+import sys
 from typing import Any
 
 
@@ -17,15 +20,40 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _plugins(args: argparse.Namespace) -> int:
-    from nmsm.core.registry import get_registry
+    """The registered classes; then one line per plugin problem (exit status 1 if any), so a
+    broken plugin does not hide the others."""
+    from nmsm.core.registry import inspect_plugins
 
-    items = get_registry().items(kind=args.kind)
+    report = inspect_plugins()
+    items = report.registry.items(kind=args.kind)
     rows = [("KIND", "NAME", "TOOLS", "DISTRIBUTION", "VERSION")]
     rows += [(it.kind, it.name, ",".join(sorted(it.tools)), it.distribution, it.version) for it in items]
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    for r in rows:
-        print("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
-    return 0
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    if report.problems:
+        lines += ["", f"{len(report.problems)} plugin problem(s): the classes concerned are not listed above, and "
+                      f"every run fails until each is fixed, uninstalled or left out with NMSM_DISABLE_PLUGINS:"]
+        lines += [f"  - {p.message}" for p in report.problems]
+    try:
+        for line in lines:
+            print(line)
+        sys.stdout.flush()
+    except BrokenPipeError:  # `nmsm plugins | head`: the reader has what it wanted
+        _discard_stdout()
+        return 0
+    return 1 if report.problems else 0
+
+
+def _discard_stdout() -> None:
+    """Send the rest of stdout (and its flush at exit) to the null device, so a closed pipe
+    prints no 'Exception ignored ... BrokenPipeError' at exit."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    except (AttributeError, OSError, ValueError, io.UnsupportedOperation):  # not a real file (tests)
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - replaces stdout until exit
+    finally:
+        os.close(devnull)
 
 
 def register(subparsers: Any) -> None:
@@ -37,6 +65,11 @@ def register(subparsers: Any) -> None:
     )
     p.set_defaults(func=_run)
 
-    p = subparsers.add_parser("plugins", help="list every registered term, constraint, controller and modifier")
-    p.add_argument("--kind", choices=["cost", "constraint", "controller", "modifier"], help="only this kind")
+    from nmsm.core.registry import KINDS
+
+    p = subparsers.add_parser(
+        "plugins",
+        help="list every registered term, constraint, controller, modifier and contact model, and broken plugins",
+    )
+    p.add_argument("--kind", choices=list(KINDS), help="only this kind")
     p.set_defaults(func=_plugins)

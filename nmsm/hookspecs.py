@@ -7,17 +7,28 @@ these very hooks (see ``[project.entry-points.nmsm]`` in nmsm's ``pyproject.toml
 
 Example plugin module::
 
+    from typing import ClassVar
+
+    import attrs
+
     from nmsm.hookspecs import hookimpl
     from nmsm.core.term import CostTerm
 
+    @attrs.frozen(kw_only=True)
     class MyTerm(CostTerm):
-        type = "my_term"
-        tools = frozenset({"DO"})
+        type: ClassVar[str] = "my_term"
+        tools: ClassVar[frozenset[str]] = frozenset({"DO"})
         ...
 
     @hookimpl
     def nmsm_cost_terms():
         return [MyTerm]
+
+The registry (:mod:`nmsm.core.registry`) checks what each hook returns when it is built: a
+list (not a single class) of subclasses of the hook's base, each with a ``type`` and
+``tools``; term classes decorated with ``@attrs.frozen(kw_only=True)``, ``type``/``tools``
+``ClassVar`` s, fields of types the settings reader reads. A function decorated with
+:data:`hookimpl` whose name is not one of these hooks (``nmsm_cost_term``) is an error too.
 """
 
 from __future__ import annotations
@@ -32,7 +43,7 @@ hookimpl = pluggy.HookimplMarker(PROJECT_NAME)
 
 
 class NmsmHookSpecs:
-    """The hooks a plugin may implement; each returns a list of classes."""
+    """The hooks a plugin may implement; each returns a list of classes (empty, or None, if none)."""
 
     @hookspec
     def nmsm_cost_terms(self) -> list[type]:

@@ -9,16 +9,31 @@ Environment variables (reproducible runs, debugging):
 ``NMSM_LOAD_PLUGINS``
     Comma-separated distribution names; only these plugins load (``nmsm`` is always loaded).
 ``NMSM_DISABLE_PLUGINS``
-    Comma-separated distribution names never loaded.
+    Comma-separated distribution names never loaded (``nmsm`` itself cannot be).
 ``NMSM_TRACE_PLUGINS``
     If set, print which plugin provided each class as the registry is built.
+
+Distribution names are compared as pip does (case, ``-``, ``_`` and ``.`` alike); a name
+that is not an installed plugin distribution is warned about.
+
+Every class is checked when the registry is built, so a plugin author gets one message naming
+the class, the plugin (entry point, distribution, version) and what was expected: a hook must
+return a list of classes of the hook's base (:data:`BASES`); a class sets a ``type`` and
+``tools``; a term class is an attrs class whose fields the settings reader can read
+(:func:`nmsm.core.term.term_class_problems`); a hook implementation must name a hook of
+:mod:`nmsm.hookspecs`. :func:`inspect_plugins` collects every problem without stopping (for
+``nmsm plugins``); :func:`build_registry` raises them.
 """
 
 from __future__ import annotations
 
+import difflib
 import os
+import re
 import sys
-from collections.abc import Iterable
+import warnings
+import weakref
+from collections.abc import Callable, Iterable
 from functools import cache
 from importlib import metadata
 
@@ -35,6 +50,15 @@ KINDS: dict[str, str] = {
     "controller": "nmsm_controllers",
     "modifier": "nmsm_model_modifiers",
     "contact": "nmsm_contact_models",
+}
+
+#: kind -> the base class its hook's classes subclass (module, class name): imported when checked
+BASES: dict[str, tuple[str, str]] = {
+    "cost": ("nmsm.core.term", "CostTerm"),
+    "constraint": ("nmsm.core.term", "ConstraintTerm"),
+    "controller": ("nmsm.core.plugin_bases", "Controller"),
+    "modifier": ("nmsm.core.plugin_bases", "ModelModifier"),
+    "contact": ("nmsm.core.plugin_bases", "ContactModel"),
 }
 
 #: Tool codes used in ``tools`` class attributes.
@@ -69,14 +93,39 @@ class RegisteredItem:
         return doc.splitlines()[0] if doc else ""
 
 
-def _split_env(name: str) -> set[str]:
-    return {p.strip() for p in os.environ.get(name, "").split(",") if p.strip()}
+#: class -> (distribution, version) of every class a registry holds (messages about a term's code)
+_ORIGINS: weakref.WeakKeyDictionary[type, tuple[str, str]] = weakref.WeakKeyDictionary()
+
+
+def origin_of(cls: type) -> tuple[str, str] | None:
+    """``(distribution, version)`` that registered ``cls`` (or a class it derives from), if any."""
+    for klass in cls.__mro__:
+        try:
+            found = _ORIGINS.get(klass)
+        except TypeError:
+            continue
+        if found is not None:
+            return found
+    return None
+
+
+def _split_env(name: str) -> list[str]:
+    return [p.strip() for p in os.environ.get(name, "").split(",") if p.strip()]
+
+
+def _normalize(name: str) -> str:
+    """A distribution name as pip compares it (PEP 503)."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def _qualified(obj: type) -> str:
+    return f"{obj.__module__}.{obj.__qualname__}"
 
 
 class Registry:
     """All registered classes, checked for duplicates when built."""
 
-    def __init__(self, items: Iterable[RegisteredItem]) -> None:
+    def __init__(self, items: Iterable[RegisteredItem] = ()) -> None:
         self._items: dict[tuple[str, str], list[RegisteredItem]] = {}
         for item in items:
             self._add(item)
@@ -85,16 +134,26 @@ class Registry:
         same = self._items.setdefault((item.kind, item.name), [])
         for other in same:
             overlap = other.tools & item.tools
-            if overlap or not (other.tools or item.tools):
+            if not (overlap or not (other.tools or item.tools)):
+                continue
+            tools = ", ".join(sorted(overlap)) or "all"
+            if other.cls is item.cls and other.distribution == item.distribution:
                 raise RegistryError(
-                    f"{item.kind} '{item.name}' is registered twice for tool(s) "
-                    f"{', '.join(sorted(overlap)) or 'all'}: by {other.cls.__module__}.{other.cls.__qualname__} "
-                    f"from distribution '{other.distribution}' {other.version} and by "
-                    f"{item.cls.__module__}.{item.cls.__qualname__} from distribution "
-                    f"'{item.distribution}' {item.version}. Uninstall one of them or set "
-                    f"NMSM_DISABLE_PLUGINS."
+                    f"{item.kind} '{item.name}' ({_qualified(item.cls)}) is registered twice for tool(s) {tools} "
+                    f"by distribution '{item.distribution}' {item.version}: its hooks return the class twice"
                 )
+            plugins = [d for d in (other.distribution, item.distribution) if _normalize(d) != PROJECT_NAME]
+            disable = " or ".join(f"NMSM_DISABLE_PLUGINS={d}" for d in dict.fromkeys(plugins))
+            raise RegistryError(
+                f"{item.kind} '{item.name}' is registered twice for tool(s) "
+                f"{tools}: by {_qualified(other.cls)} "
+                f"from distribution '{other.distribution}' {other.version} and by "
+                f"{_qualified(item.cls)} from distribution "
+                f"'{item.distribution}' {item.version}. Uninstall one of them"
+                + (f" or leave one out with {disable}." if disable else ".")
+            )
         same.append(item)
+        _ORIGINS[item.cls] = (item.distribution, item.version)
 
     def items(self, kind: str | None = None, tool: str | None = None) -> list[RegisteredItem]:
         """Registered items, sorted by kind then name, optionally filtered."""
@@ -131,75 +190,267 @@ class Registry:
         raise RegistryError(f"unknown {kind} '{name}' for {tool}. Valid {kind} names for {tool}: {valid}")
 
 
-def _plugin_manager() -> tuple[pluggy.PluginManager, dict[int, tuple[str, str]]]:
-    """Load every ``nmsm`` entry point; return the manager and plugin -> (dist, version)."""
-    pm = pluggy.PluginManager(PROJECT_NAME)
-    pm.add_hookspecs(NmsmHookSpecs)
+@attrs.frozen
+class PluginSource:
+    """One plugin to load: an ``nmsm`` entry point of an installed distribution.
+
+    ``load`` returns the plugin object (a module, or any object with hook functions). Tests
+    and tools that hold a plugin object already build one with :meth:`of`.
+    """
+
+    name: str
+    value: str
+    distribution: str
+    version: str
+    load: Callable[[], object] = attrs.field(eq=False, repr=False)
+
+    @classmethod
+    def of(cls, plugin: object, distribution: str, version: str = "0", name: str | None = None) -> PluginSource:
+        """A plugin object at hand, as if ``distribution`` named it by an entry point."""
+        value = getattr(plugin, "__name__", None) or type(plugin).__name__
+        return cls(name or value, value, distribution, version, lambda: plugin)
+
+    @property
+    def label(self) -> str:
+        """``plugin 'NAME = VALUE' of distribution 'DIST' VERSION``, for messages."""
+        return f"plugin '{self.name} = {self.value}' of distribution '{self.distribution}' {self.version}"
+
+    @property
+    def is_nmsm(self) -> bool:
+        return _normalize(self.distribution) == PROJECT_NAME
+
+    @property
+    def remedy(self) -> str:
+        """How to run without this plugin (nothing for nmsm's own)."""
+        if self.is_nmsm:
+            return "(nmsm's own plugin: please report this)"
+        return (f"Fix or uninstall '{self.distribution}', or leave it out with "
+                f"NMSM_DISABLE_PLUGINS={self.distribution}")
+
+
+@attrs.frozen
+class PluginProblem:
+    """Why a plugin, or one of its classes, is left out of the registry."""
+
+    distribution: str
+    plugin: str
+    message: str
+
+
+@attrs.frozen
+class PluginReport:
+    """The registry of every class that passed the checks, and every problem found."""
+
+    registry: Registry
+    problems: tuple[PluginProblem, ...]
+
+    def raise_problems(self) -> None:
+        """:class:`RegistryError` listing every problem (nothing if none)."""
+        if len(self.problems) == 1:
+            raise RegistryError(self.problems[0].message)
+        if self.problems:
+            lines = "\n".join(f"  - {p.message}" for p in self.problems)
+            raise RegistryError(f"{len(self.problems)} plugin problems (nmsm plugins lists them):\n{lines}")
+
+
+def discover_plugins() -> list[PluginSource]:
+    """Every ``nmsm`` entry point of the installed distributions, nmsm's own first, after
+    ``NMSM_LOAD_PLUGINS`` / ``NMSM_DISABLE_PLUGINS``."""
     only = _split_env("NMSM_LOAD_PLUGINS")
     disabled = _split_env("NMSM_DISABLE_PLUGINS")
-    origin: dict[int, tuple[str, str]] = {}
-    seen: set[tuple[str, str]] = set()
+    if any(_normalize(name) == PROJECT_NAME for name in disabled):
+        raise RegistryError(
+            f"NMSM_DISABLE_PLUGINS names '{PROJECT_NAME}': nmsm's own terms, constraints, controllers and "
+            f"modifiers register as the '{PROJECT_NAME}' plugin and cannot be left out (remove it from "
+            f"NMSM_DISABLE_PLUGINS; name third-party distributions only)"
+        )
+    found: list[PluginSource] = []
+    seen: set[tuple[str, str, str]] = set()
     for dist in metadata.distributions():
         dist_name = dist.metadata["Name"] or "?"
         for ep in dist.entry_points:
             if ep.group != ENTRY_POINT_GROUP:
                 continue
-            key = (dist_name, ep.value)
+            key = (_normalize(dist_name), ep.name, ep.value)
             if key in seen:  # the same distribution found twice on sys.path
                 continue
             seen.add(key)
-            if dist_name in disabled:
-                continue
-            if only and dist_name != PROJECT_NAME and dist_name not in only:
-                continue
-            try:
-                plugin = ep.load()
-            except Exception as exc:  # a broken third-party plugin must say who it is
-                raise RegistryError(
-                    f"plugin entry point '{ep.name} = {ep.value}' of distribution "
-                    f"'{dist_name}' {dist.version} failed to load: {exc!r}"
-                ) from exc
-            if pm.is_registered(plugin):
-                continue
-            pm.register(plugin, name=f"{dist_name}:{ep.name}")
-            origin[id(plugin)] = (dist_name, dist.version)
-    return pm, origin
+            found.append(PluginSource(ep.name, ep.value, dist_name, dist.version, ep.load))
+    installed = {_normalize(src.distribution): src.distribution for src in found}
+    for variable, names in (("NMSM_LOAD_PLUGINS", only), ("NMSM_DISABLE_PLUGINS", disabled)):
+        unknown = [name for name in names if _normalize(name) not in installed and _normalize(name) != PROJECT_NAME]
+        if unknown:
+            listed = ", ".join(sorted(installed.values(), key=_normalize)) or "(none)"
+            warnings.warn(
+                f"{variable} names {', '.join(repr(n) for n in unknown)}, not an installed nmsm plugin distribution "
+                f"(installed: {listed}); ignored",
+                stacklevel=3,
+            )
+    keep_only = {_normalize(n) for n in only}
+    leave_out = {_normalize(n) for n in disabled}
+    out = [
+        src for src in found
+        if _normalize(src.distribution) not in leave_out
+        and (not keep_only or src.is_nmsm or _normalize(src.distribution) in keep_only)
+    ]
+    # nmsm's own first: a clash with a built-in name then blames the plugin
+    return sorted(out, key=lambda src: (not src.is_nmsm, _normalize(src.distribution), src.name))
 
 
-def build_registry() -> Registry:
-    """Discover plugins through entry points and build a fresh :class:`Registry`."""
-    pm, origin = _plugin_manager()
-    trace = bool(os.environ.get("NMSM_TRACE_PLUGINS"))
-    items: list[RegisteredItem] = []
-    for kind, hook_name in KINDS.items():
-        caller = getattr(pm.hook, hook_name)
-        for impl in caller.get_hookimpls():
-            classes = impl.function() or []
-            dist, version = origin.get(id(impl.plugin), ("?", "?"))
-            for cls in classes:
-                name = getattr(cls, "type", None) or getattr(cls, "name", None)
-                if not isinstance(name, str) or not name:
-                    raise RegistryError(
-                        f"{kind} class {cls.__module__}.{cls.__qualname__} from distribution "
-                        f"'{dist}' has no 'type' name"
-                    )
-                tools = frozenset(getattr(cls, "tools", frozenset()))
-                unknown = tools - set(TOOL_NAMES)
-                if unknown:
-                    raise RegistryError(
-                        f"{kind} '{name}' from distribution '{dist}' names unknown tool(s) "
-                        f"{sorted(unknown)} (expected any of {', '.join(TOOL_NAMES)})"
-                    )
-                item = RegisteredItem(kind, name, cls, tools, dist, version, impl.plugin_name)
-                if trace:
-                    print(f"[nmsm plugins] {kind} {name} <- {dist} {version} ({impl.plugin_name})", file=sys.stderr)
-                items.append(item)
-    if not any(dist == PROJECT_NAME for dist, _ in origin.values()):
+def _describe(obj: object) -> str:
+    """A returned object for messages: ``'text' (a str)``, ``mod.Class (a class)``."""
+    if isinstance(obj, type):
+        return f"{_qualified(obj)} (a class)"
+    text = repr(obj)
+    if len(text) > 80:
+        text = text[:77] + "..."
+    return f"{text} (a {type(obj).__name__})"
+
+
+def _base(kind: str) -> type:
+    import importlib
+
+    module, name = BASES[kind]
+    return getattr(importlib.import_module(module), name)
+
+
+def _check_class(kind: str, obj: object) -> tuple[str, frozenset[str], list[str]]:
+    """``(name, tools, problems)`` of a class returned by ``kind``'s hook."""
+    assert isinstance(obj, type)
+    base = _base(kind)
+    if not issubclass(obj, base):
+        text = f"is not a subclass of {_qualified(base)}, the base of {kind} classes"
+        for other_kind in KINDS:
+            other = _base(other_kind)
+            if other_kind != kind and issubclass(obj, other):
+                text += f" (it is a {other.__name__}: return it from {KINDS[other_kind]}())"
+                break
+        return "", frozenset(), [text]
+    from nmsm.core.term import Term, term_class_problems
+
+    if issubclass(obj, Term):
+        problems = term_class_problems(obj)
+        if problems:
+            return "", frozenset(), problems
+    problems = []
+    name = getattr(obj, "type", None) or getattr(obj, "name", None)
+    if not isinstance(name, str) or not name:
+        problems.append("sets no 'type' (its settings name): add type: ClassVar[str] = \"my_name\"")
+        name = ""
+    raw = getattr(obj, "tools", None)
+    tools: frozenset[str] = frozenset()
+    expected = f"codes among {', '.join(TOOL_NAMES)}"
+    if isinstance(raw, str):
+        problems.append(f"sets 'tools' to the string {raw!r}, not a set of tool codes "
+                        f"(write tools: ClassVar[frozenset[str]] = frozenset({{{raw!r}}}); {expected})")
+    elif not isinstance(raw, (set, frozenset, tuple, list)) or not all(isinstance(t, str) for t in raw):
+        problems.append(f"sets 'tools' to {_describe(raw)}, not a set of tool codes "
+                        f"(write tools: ClassVar[frozenset[str]] = frozenset({{...}}); {expected})")
+    else:
+        tools = frozenset(raw)
+        unknown = tools - set(TOOL_NAMES)
+        if unknown:
+            problems.append(f"names unknown tool(s) {sorted(unknown)} (expected any of {', '.join(TOOL_NAMES)})")
+        elif not tools:
+            problems.append(f"sets no tools, so no tool could ever use it (write tools: ClassVar[frozenset[str]] = "
+                            f"frozenset({{...}}) with {expected})")
+    return name, tools, problems
+
+
+def inspect_plugins(plugins: Iterable[PluginSource] | None = None) -> PluginReport:
+    """Load ``plugins`` (default: :func:`discover_plugins`) and check every class, without stopping.
+
+    Each problem (a plugin that does not load, a hook that raises or returns something other
+    than a list of classes, a class of the wrong base or that no settings file could use, an
+    unknown hook, a name registered twice) is reported with the plugin and left out; the
+    returned registry holds the rest.
+    """
+    sources = discover_plugins() if plugins is None else list(plugins)
+    if not any(src.is_nmsm for src in sources):
         raise RegistryError(
             "no nmsm plugins found: the built-in terms register through the 'nmsm' entry-point "
             "group, so nmsm must be installed (pip install -e . or pip install .), not only on sys.path"
         )
-    return Registry(items)
+    trace = bool(os.environ.get("NMSM_TRACE_PLUGINS"))
+    pm = pluggy.PluginManager(PROJECT_NAME)
+    pm.add_hookspecs(NmsmHookSpecs)
+    problems: list[PluginProblem] = []
+
+    def problem(src: PluginSource, text: str, *, remedy: bool = True) -> None:
+        problems.append(PluginProblem(src.distribution, src.name, f"{text}. {src.remedy}" if remedy else text))
+
+    by_plugin: dict[int, PluginSource] = {}
+    for src in sources:
+        try:
+            plugin = src.load()
+        except Exception as exc:  # a broken third-party plugin must say who it is
+            problem(src, f"{src.label} failed to load: {type(exc).__name__}: {exc}")
+            continue
+        if pm.is_registered(plugin):  # one module named by two entry points
+            continue
+        try:
+            pm.register(plugin, name=f"{src.distribution}:{src.name}")
+        except Exception as exc:  # pluggy: a hook implementation whose arguments the hook does not have
+            problem(src, f"{src.label} cannot be registered: {type(exc).__name__}: {exc}")
+            continue  # its hooks registered before the error are skipped below (not in by_plugin)
+        by_plugin[id(plugin)] = src
+        for hook_name in KINDS.values():
+            if callable(getattr(plugin, hook_name, None)) and pm.parse_hookimpl_opts(plugin, hook_name) is None:
+                problem(src, f"{src.label} defines {hook_name}() without @hookimpl "
+                             f"(from nmsm.hookspecs import hookimpl), so nmsm never calls it")
+        for caller in pm.get_hookcallers(plugin) or ():
+            if caller.has_spec() or all(i.optionalhook for i in caller.get_hookimpls() if i.plugin is plugin):
+                continue
+            close = difflib.get_close_matches(caller.name, list(KINDS.values()), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            problem(src, f"{src.label} implements unknown hook '{caller.name}'{hint}, which nmsm never calls; "
+                         f"valid hooks: {', '.join(KINDS.values())}")
+
+    registry = Registry()
+    for kind, hook_name in KINDS.items():
+        for impl in getattr(pm.hook, hook_name).get_hookimpls():
+            src = by_plugin.get(id(impl.plugin))
+            if src is None:  # a plugin pluggy refused (reported above)
+                continue
+            try:
+                returned = impl.function()
+            except Exception as exc:
+                problem(src, f"{src.label}: hook {hook_name}() raised {type(exc).__name__}: {exc}")
+                continue
+            if returned is None:  # pluggy's "nothing to add"
+                continue
+            if not isinstance(returned, (list, tuple)):
+                hint = f" (write return [{returned.__name__}])" if isinstance(returned, type) else ""
+                problem(src, f"{src.label}: hook {hook_name}() returned {_describe(returned)}, not a list of "
+                             f"classes{hint}")
+                continue
+            for obj in returned:
+                if not isinstance(obj, type):
+                    problem(src, f"{src.label}: hook {hook_name}() returned {_describe(obj)} in its list, not a class")
+                    continue
+                name, tools, issues = _check_class(kind, obj)
+                for issue in issues:
+                    problem(src, f"{src.label}: class {_qualified(obj)} returned by {hook_name}() {issue}")
+                if issues:
+                    continue
+                item = RegisteredItem(kind, name, obj, tools, src.distribution, src.version, impl.plugin_name)
+                try:
+                    registry._add(item)
+                except RegistryError as exc:
+                    problem(src, str(exc), remedy="NMSM_DISABLE_PLUGINS" not in str(exc))
+                    continue
+                if trace:
+                    print(f"[nmsm plugins] {kind} {name} <- {src.distribution} {src.version} ({impl.plugin_name})",
+                          file=sys.stderr)
+    return PluginReport(registry, tuple(problems))
+
+
+def build_registry(plugins: Iterable[PluginSource] | None = None) -> Registry:
+    """Discover plugins through entry points (or load ``plugins``) and build a fresh
+    :class:`Registry`; :class:`RegistryError` naming every plugin problem found."""
+    report = inspect_plugins(plugins)
+    report.raise_problems()
+    return report.registry
 
 
 @cache

@@ -26,15 +26,18 @@ Writing a term::
 
 from __future__ import annotations
 
+import functools
 import itertools
+import math
+import types
 import typing
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar, Protocol
 
 import attrs
 
-from nmsm.errors import InputError
+from nmsm.errors import InputError, NmsmError, RegistryError
 
 
 @attrs.frozen
@@ -126,7 +129,7 @@ def _convert(text: str, annotation: Any) -> Any:
     if annotation is bool:
         return parse_bool(text)
     if annotation is int:
-        return int(float(text))
+        return _integer(text)
     if annotation is float:
         return float(text)
     if annotation is str:
@@ -137,6 +140,175 @@ def _convert(text: str, annotation: Any) -> Any:
         values = [_convert(i, item_type) for i in items]
         return tuple(values) if origin is tuple else values
     return text.strip()
+
+
+def _integer(text: str) -> int:
+    """``"3"`` or ``"3.0"`` -> 3; ``"2.7"`` is refused rather than truncated."""
+    stripped = text.strip()
+    try:
+        return int(stripped)
+    except ValueError:
+        pass
+    value = float(stripped)  # ValueError for text that is no number at all
+    if not value.is_integer():
+        raise ValueError(f"'{stripped}' is not an integer")
+    return int(value)
+
+
+#: Scalar field types the settings reader converts (see :func:`_convert`).
+_SCALARS: tuple[type, ...] = (str, int, float, bool)
+
+#: The field annotations :func:`_convert` reads, for messages.
+SUPPORTED_FIELD_TYPES = "str, int, float, bool, X | None, tuple[X, ...] and list[X] with X one of str, int, float, bool"
+
+#: Fields whose value must be a finite number (a NaN or an infinity makes the term meaningless).
+_FINITE_FIELDS = ("max_allowable_error", "error_center", "min_error", "max_error")
+
+
+def readable_annotation(annotation: Any) -> bool:
+    """True if :func:`_convert` turns element text into a value of type ``annotation``
+    (:data:`SUPPORTED_FIELD_TYPES`); anything else would reach the term as raw text."""
+    if annotation in _SCALARS:
+        return True
+    origin = typing.get_origin(annotation)
+    args = typing.get_args(annotation)
+    if origin in (typing.Union, types.UnionType):
+        inner = [a for a in args if a is not type(None)]
+        return len(inner) == 1 and type(None) in args and readable_annotation(inner[0])
+    if origin in (tuple, list):
+        items = {a for a in args if a is not Ellipsis}
+        return len(items) == 1 and next(iter(items)) in _SCALARS
+    return False
+
+
+def _type_name(annotation: Any) -> str:
+    if isinstance(annotation, type) and not typing.get_args(annotation):
+        return annotation.__qualname__ if annotation.__module__ == "builtins" else \
+            f"{annotation.__module__}.{annotation.__qualname__}"
+    return repr(annotation).replace("typing.", "")
+
+
+def _qualified(cls: type) -> str:
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
+def _is_classvar(annotation: Any) -> bool:
+    if isinstance(annotation, str):  # ``from __future__ import annotations``
+        return annotation.strip().startswith(("ClassVar", "typing.ClassVar", "t.ClassVar"))
+    return annotation is ClassVar or typing.get_origin(annotation) is ClassVar
+
+
+def term_class_problems(cls: type[Term]) -> list[str]:
+    """What makes ``cls`` (a :class:`Term` subclass) unusable from settings XML, checked when
+    the plugin registry is built (:mod:`nmsm.core.registry`); empty if nothing.
+
+    A term must be decorated with ``@attrs.frozen(kw_only=True)`` (its fields are its settings
+    elements), keep ``type`` and ``tools`` as ``ClassVar`` s, and annotate every field with a
+    type the settings reader converts (:data:`SUPPORTED_FIELD_TYPES`) unless the field has a
+    ``converter`` that takes the element's text.
+    """
+    out: list[str] = []
+    for klass in cls.__mro__:
+        if not issubclass(klass, Term) or "__attrs_attrs__" in klass.__dict__:
+            continue
+        own = [name for name, annotation in klass.__dict__.get("__annotations__", {}).items()
+               if not _is_classvar(annotation)]
+        if klass is cls or own:
+            text = "is not decorated" if klass is cls else f"has a base {_qualified(klass)} not decorated"
+            text += " with @attrs.frozen(kw_only=True)"
+            if len(own) == 1:
+                text += f": '{own[0]}' would not be a field, so its settings element <{own[0]}> would be refused"
+            elif own:
+                text += (f": {', '.join(repr(n) for n in own)} would not be fields, so their settings elements "
+                         f"would be refused")
+            out.append(text)
+    if out:
+        return out
+    fields = attrs.fields_dict(cls)
+    for name, kind in (("type", "str"), ("tools", "frozenset[str]"), ("kind", "str"), ("aliases", "dict[str, str]")):
+        if name in fields:
+            default = fields[name].default
+            example = "..." if default is attrs.NOTHING or isinstance(default, attrs.Factory) else repr(default)
+            out.append(f"sets '{name}' as an attrs field, but '{name}' must be a ClassVar[{kind}], not an attrs "
+                       f"field (write {name}: ClassVar[{kind}] = {example})")
+    if out:
+        return out
+    try:
+        hints = cls.xml_fields()
+    except Exception as exc:  # get_type_hints: a name in an annotation that cannot be resolved
+        return [f"has field annotations that cannot be resolved ({type(exc).__name__}: {exc})"]
+    for name, annotation in hints.items():
+        if fields[name].converter is None and not readable_annotation(annotation):
+            out.append(f"has field '{name}' annotated {_type_name(annotation)}, which the settings reader cannot "
+                       f"read (supported: {SUPPORTED_FIELD_TYPES}; or give the field a converter taking the "
+                       f"element's text)")
+    return out
+
+
+class TermCodeError(RegistryError):
+    """A term's own code (``bind``, ``quantity``, ``value``, ...) raised an exception that is not
+    an nmsm error: a bug in the term (often a plugin's). The message names the settings file
+    and line, the term type, its class and the class's distribution; the original exception
+    is chained (``--traceback`` shows where it was raised)."""
+
+    def __init__(self, term: Term, method: str, exc: BaseException) -> None:
+        self.term = term
+        self.method = method
+        self.original = exc
+        cls = type(term)
+        where = ""
+        if term.source.file:
+            where = term.source.file + (f":{term.source.line}" if term.source.line is not None else "") + ": "
+        owner = _qualified(cls)
+        from nmsm.core.registry import origin_of
+
+        origin = origin_of(cls)
+        if origin is not None and origin[0] != "nmsm":
+            owner += f" from distribution '{origin[0]}' {origin[1]}"
+        detail = str(exc)
+        error = type(exc).__name__ + (f" {detail}" if detail else "")
+        label = f"term '{term.type}'" + (f" ({term.name})" if term.name else "")
+        super().__init__(f"{where}{label} ({owner}) failed while building its expression, in {method}(): "
+                         f"{error} (run with --traceback for details)")
+
+
+#: Term methods whose exceptions are reported by :class:`TermCodeError`.
+_GUARDED_METHODS = ("bind", "quantity", "normalized", "residuals", "value", "bounded")
+
+
+class _GuardedMethod:
+    """A term method that turns an exception other than an nmsm error into a
+    :class:`TermCodeError` naming the term (``raise ... from`` the original).
+
+    Installed by :meth:`Term.__init_subclass__` on every method of :data:`_GUARDED_METHODS` a
+    term class defines, so every caller (problem builders, scoring, comparisons) gets the
+    message. ``__closure__`` exposes the function's cells so attrs re-points the ``__class__``
+    cell of ``super()`` calls when it rebuilds a slotted class.
+    """
+
+    def __init__(self, func: Callable[..., Any]) -> None:
+        self.__func__ = func
+
+        @functools.wraps(func)
+        def guarded(term: Term, *args: Any, **kwargs: Any) -> Any:
+            try:
+                return func(term, *args, **kwargs)
+            except NmsmError:
+                raise  # raised on purpose (term.error(...), ctx.require_...): already says what is wrong
+            except Exception as exc:
+                raise TermCodeError(term, func.__name__, exc) from exc
+
+        self._guarded = guarded
+        functools.update_wrapper(self, func)
+
+    @property
+    def __closure__(self) -> Any:
+        return self.__func__.__closure__
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self._guarded
+        return types.MethodType(self._guarded, instance)
 
 
 @attrs.frozen(kw_only=True)
@@ -159,6 +331,13 @@ class Term:
     source: SourceRef = attrs.field(factory=SourceRef, eq=False, repr=False)
     #: the term's settings elements as written in its file -> line (messages name what the file says)
     element_lines: Mapping[str, int | None] = attrs.field(factory=dict, eq=False, repr=False)
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for method in _GUARDED_METHODS:
+            func = cls.__dict__.get(method)
+            if isinstance(func, types.FunctionType):
+                setattr(cls, method, _GuardedMethod(func))
 
     # ----- construction from settings -------------------------------------------------
     @classmethod
@@ -225,15 +404,19 @@ class Term:
                     stacklevel=2,
                 )
                 continue
+            element, line = _as_written(cls, spec.field_lines, key, spec.source.line)
             try:
                 values[key] = _convert(text, fields[key])
             except (TypeError, ValueError) as exc:
                 raise InputError(
-                    f"cannot read <{key}> = '{text}' of term '{cls.type}': {exc}",
+                    f"cannot read {element} = '{text}' of term '{cls.type}': {exc}",
                     file=spec.source.file,
-                    line=spec.field_lines.get(key, spec.source.line),
+                    line=line,
                     expected=f"{getattr(fields[key], '__name__', fields[key])}",
                 ) from exc
+            if key in _FINITE_FIELDS and isinstance(values[key], float) and not math.isfinite(values[key]):
+                raise InputError(f"term '{cls.type}': '{text.strip()}' is not a finite number", file=spec.source.file,
+                                 line=line, element=element, expected="a finite number")
         term_element = f"<{'RCNLCostTerm' if spec.kind == 'cost' else 'RCNLConstraintTerm'}>"
         missing = cls._missing_required(set(values) | set(splits))
         if missing:
@@ -293,6 +476,13 @@ class Term:
             if value not in (None, ""):
                 parts.append(str(value))
         return ":".join(parts)
+
+
+def _location(file: str | None, line: int | None) -> str:
+    """``"FILE:LINE: "`` (or what is known of it) for warnings."""
+    if not file:
+        return "" if line is None else f"line {line}: "
+    return f"{file}:{line}: " if line is not None else f"{file}: "
 
 
 def _number(value: Any) -> str:
@@ -368,15 +558,28 @@ class ConstraintTerm(Term):
 def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> list[Term]:
     """Registered term instances for the enabled specs of ``tool``, in declaration order.
 
-    Unknown or disallowed type names raise :class:`InputError` naming the file and line.
+    A term without ``<is_enabled>`` is not used (the original's default, false), with a
+    warning; an ``<is_enabled>`` other than true/false, and unknown or disallowed type names,
+    raise :class:`InputError` naming the file and line.
     """
     from nmsm.core.registry import get_registry
-    from nmsm.errors import RegistryError
 
     registry = registry or get_registry()
     out: list[Term] = []
     for spec in specs:
-        enabled = parse_bool(spec.fields.get("is_enabled", "false"))
+        tag = "RCNLCostTerm" if spec.kind == "cost" else "RCNLConstraintTerm"
+        where = _location(spec.source.file, spec.source.line)
+        if "is_enabled" not in spec.fields:  # the original's default: false (spec settings-xml.md)
+            warnings.warn(f"{where}<{tag}> '{spec.type}' has no <is_enabled>: not used "
+                          f"(write <is_enabled>true</is_enabled>)", stacklevel=2)
+            continue
+        text = spec.fields["is_enabled"]
+        try:
+            enabled = parse_bool(text)
+        except ValueError as exc:
+            raise InputError(f"<{tag}> '{spec.type}': <is_enabled> is '{text}'", file=spec.source.file,
+                             line=spec.field_lines.get("is_enabled", spec.source.line), element="<is_enabled>",
+                             expected="true or false") from exc
         if not enabled:
             continue
         try:

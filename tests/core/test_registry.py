@@ -91,3 +91,44 @@ def test_broken_plugin_names_its_distribution(extra_path: Path) -> None:
     _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", "raise ImportError('boom')\n")
     with pytest.raises(RegistryError, match="fake-plugin-a.*failed to load.*boom"):
         build_registry()
+
+
+def test_broken_plugin_says_how_to_leave_it_out(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", "raise ImportError('boom')\n")
+    with pytest.raises(RegistryError) as info:
+        build_registry()
+    assert str(info.value) == (
+        "plugin 'fake_plugin_a = fake_plugin_a' of distribution 'fake-plugin-a' 1.2.3 failed to load: ImportError: "
+        "boom. Fix or uninstall 'fake-plugin-a', or leave it out with NMSM_DISABLE_PLUGINS=fake-plugin-a")
+
+
+def test_a_name_clash_names_the_plugin_to_leave_out(extra_path: Path) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a",
+                       _TERM_MODULE.format(name="generalized_coordinate_tracking").replace('{"DO"}', '{"TO"}'))
+    with pytest.raises(RegistryError, match="by nmsm.terms.* from distribution 'nmsm' .* and by fake_plugin_a.Dup "
+                                            "from distribution 'fake-plugin-a' 1.2.3. Uninstall one of them or leave "
+                                            "one out with NMSM_DISABLE_PLUGINS=fake-plugin-a."):
+        build_registry()
+
+
+def test_environment_naming_a_distribution_not_installed_is_warned(extra_path: Path, monkeypatch) -> None:
+    _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="fancy_goal"))
+    monkeypatch.setenv("NMSM_LOAD_PLUGINS", "Fake_Plugin_A,fake-plugin-z")  # names compare as pip compares them
+    with pytest.warns(UserWarning) as record:
+        registry = build_registry()
+    assert registry.get("cost", "fancy_goal", "DO").__module__ == "fake_plugin_a"
+    (message,) = [str(w.message) for w in record]
+    assert message.startswith("NMSM_LOAD_PLUGINS names 'fake-plugin-z', not an installed nmsm plugin distribution "
+                              "(installed: ")
+    assert "fake-plugin-a" in message and "nmsm" in message
+    monkeypatch.delenv("NMSM_LOAD_PLUGINS")
+    monkeypatch.setenv("NMSM_DISABLE_PLUGINS", "fake-plugin-y")
+    with pytest.warns(UserWarning, match="NMSM_DISABLE_PLUGINS names 'fake-plugin-y', not an installed"):
+        build_registry()
+
+
+def test_disabling_nmsm_itself_is_refused(monkeypatch) -> None:
+    monkeypatch.setenv("NMSM_DISABLE_PLUGINS", "NMSM")
+    with pytest.raises(RegistryError, match="NMSM_DISABLE_PLUGINS names 'nmsm': nmsm's own terms, .* cannot be left "
+                                            "out"):
+        build_registry()

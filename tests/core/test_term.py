@@ -91,3 +91,75 @@ def test_constraint_aliases_and_order() -> None:
     assert (c.min_error, c.max_error) == (-3.0, 2.0)
     with pytest.raises(InputError, match="min_error"):
         _C.from_spec(TermSpec("constraint", "c", {"max_error": "-2", "min_error": "3"}))
+
+
+# ----- reading values (an int is not truncated; normalization numbers are finite) -----------------
+@attrs.frozen(kw_only=True)
+class _Counted(CostTerm):
+    type: ClassVar[str] = "counted"
+    tools: ClassVar[frozenset[str]] = frozenset({"MTP"})
+    count: int = 1
+
+
+def test_int_field_refuses_a_fraction_and_names_the_element_and_line() -> None:
+    spec = TermSpec("cost", "counted", {"count": "2.7"}, SourceRef("s.xml", 3), {"count": 5})
+    with pytest.raises(InputError, match=r"s.xml:5: cannot read <count> = '2.7' of term 'counted': '2.7' is not an "
+                                         r"integer \(expected int\)"):
+        _Counted.from_spec(spec)
+    assert [t.count for t in _Counted.from_spec(TermSpec("cost", "counted", {"count": "3"}))] == [3]
+    assert [t.count for t in _Counted.from_spec(TermSpec("cost", "counted", {"count": "4.0"}))] == [4]
+
+
+@pytest.mark.parametrize("element, text", [
+    ("max_allowable_error", "inf"), ("error_center", "nan"), ("error_center", "-Infinity"),
+])
+def test_non_finite_cost_normalization_is_refused(element: str, text: str) -> None:
+    spec = TermSpec("cost", "offsets", {element: text}, SourceRef("s.xml", 3), {element: 8})
+    with pytest.raises(InputError) as info:
+        _Offsets.from_spec(spec)
+    assert str(info.value) == (f"s.xml:8: <{element}>: term 'offsets': '{text}' is not a finite number "
+                               f"(expected a finite number)")
+
+
+def test_non_finite_constraint_bounds_are_refused_as_written() -> None:
+    @attrs.frozen(kw_only=True)
+    class _C(ConstraintTerm):
+        type: ClassVar[str] = "c"
+        tools: ClassVar[frozenset[str]] = frozenset({"TO"})
+
+    spec = TermSpec("constraint", "c", {"max_value": "inf"}, SourceRef("s.xml", 3), {"max_value": 6})
+    with pytest.raises(InputError, match=r"s.xml:6: <max_value>: term 'c': 'inf' is not a finite number"):
+        _C.from_spec(spec)
+    spec = TermSpec("constraint", "c", {"min_error": "nan"}, SourceRef("s.xml", 3), {"min_error": 7})
+    with pytest.raises(InputError, match=r"s.xml:7: <min_error>: term 'c': 'nan' is not a finite number"):
+        _C.from_spec(spec)
+
+
+# ----- <is_enabled> ------------------------------------------------------------------------------
+class _OnlyOffsets:
+    """A registry holding only :class:`_Offsets`."""
+
+    def get(self, kind, name, tool):
+        return _Offsets
+
+
+def test_a_term_without_is_enabled_is_not_used_and_warned_about() -> None:
+    from nmsm.core.term import build_terms
+
+    specs = [TermSpec("cost", "offsets", {"values": "1"}, SourceRef("s.xml", 21)),
+             TermSpec("cost", "offsets", {"is_enabled": "true", "values": "2"}, SourceRef("s.xml", 25))]
+    with pytest.warns(UserWarning) as record:
+        terms = build_terms(specs, "MTP", registry=_OnlyOffsets())
+    assert [t.values for t in terms] == [(2.0,)]
+    assert [str(w.message) for w in record] == [
+        "s.xml:21: <RCNLCostTerm> 'offsets' has no <is_enabled>: not used (write <is_enabled>true</is_enabled>)"]
+
+
+def test_is_enabled_other_than_true_or_false_names_file_line_and_element() -> None:
+    from nmsm.core.term import build_terms
+
+    spec = TermSpec("cost", "offsets", {"is_enabled": "yes"}, SourceRef("s.xml", 21), {"is_enabled": 22})
+    with pytest.raises(InputError) as info:
+        build_terms([spec], "MTP", registry=_OnlyOffsets())
+    assert str(info.value) == ("s.xml:22: <is_enabled>: <RCNLCostTerm> 'offsets': <is_enabled> is 'yes' "
+                               "(expected true or false)")
