@@ -243,6 +243,15 @@ def test_export_loads_need_treatment(work: Path, capsys) -> None:
     assert sorted(p.name for p in (work / "out").iterdir()) == []
 
 
+def test_options_that_would_be_ignored_are_refused(work: Path, capsys) -> None:
+    err = _fails(["export", "leg.osimx", "-o", "out/x.osim", "--trial", "walk"], capsys)
+    assert "--trial names a trial of --treatment's results" in err
+    err = _fails(["surrogate", "--model", "leg.osim", "--data-dir", "data", "--coordinates", "knee_angle_r",
+                  "-o", "out/s.json", "--write-samples", "out/samples"], capsys)
+    assert "--write-samples keeps the poses sampled around a --motion" in err
+    assert sorted(p.name for p in (work / "out").iterdir()) == []
+
+
 def test_plot_removes_the_folder_it_created_when_it_draws_nothing(work: Path, capsys) -> None:
     capsys.readouterr()
     assert main(["plot", "bad_jmp", "-o", "out/p"]) == 1

@@ -152,8 +152,30 @@ class Registry:
                 f"'{item.distribution}' {item.version}. Uninstall one of them"
                 + (f" or leave one out with {disable}." if disable else ".")
             )
+        if item.kind == "controller":
+            self._check_controller_element(item)
         same.append(item)
         _ORIGINS[item.cls] = (item.distribution, item.version)
+
+    def _check_controller_element(self, item: RegisteredItem) -> None:
+        """A controller's settings element selects it: two controllers for the same element
+        and tool would leave one of them unreachable."""
+        element = getattr(item.cls, "settings_element", "")
+        if not element:
+            raise RegistryError(f"controller '{item.name}' ({_qualified(item.cls)}) of distribution "
+                                f"'{item.distribution}' {item.version} sets no settings_element, so no settings "
+                                "file could select it (write settings_element: ClassVar[str] = \"MyController\")")
+        for (kind, _), group in self._items.items():
+            for other in group:
+                overlap = other.tools & item.tools
+                if kind != "controller" or not overlap or getattr(other.cls, "settings_element", "") != element:
+                    continue
+                raise RegistryError(
+                    f"controllers '{other.name}' ({_qualified(other.cls)}, distribution '{other.distribution}') and "
+                    f"'{item.name}' ({_qualified(item.cls)}, distribution '{item.distribution}') both handle "
+                    f"<{element}> in {', '.join(sorted(overlap))}: a settings file could select only one of them. "
+                    "Give one another settings_element, or uninstall one"
+                )
 
     def items(self, kind: str | None = None, tool: str | None = None) -> list[RegisteredItem]:
         """Registered items, sorted by kind then name, optionally filtered."""

@@ -419,3 +419,26 @@ def test_inspect_plugins_keeps_the_good_classes(install) -> None:
     report = inspect_plugins()
     assert report.registry.get("cost", "check_goal", "TO") is _Goal
     assert [p.distribution for p in report.problems] == [DIST]
+
+
+# ----- controllers: the settings element selects them --------------------------------------------------
+class _TorqueLike(Controller):
+    type = "check_torque_like"
+    settings_element = "RCNLTorqueController"
+
+
+class _NoElement(Controller):
+    type = "check_no_element"
+
+
+def test_two_controllers_for_one_settings_element_are_refused(install) -> None:
+    install(nmsm_controllers=lambda: [_TorqueLike])
+    with pytest.raises(RegistryError, match=r"both handle <RCNLTorqueController> in DO, TO, VO: a settings file "
+                                            r"could select only one of them"):
+        build_registry()
+
+
+def test_a_controller_without_a_settings_element_is_refused(install) -> None:
+    install(nmsm_controllers=lambda: [_NoElement])
+    with pytest.raises(RegistryError, match=r"controller 'check_no_element' .* sets no settings_element"):
+        build_registry()

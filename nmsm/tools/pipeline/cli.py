@@ -87,6 +87,9 @@ def _check_export(args: argparse.Namespace) -> tuple[Path | None, Path | None, A
         raise InputError("--treatment needs --loads", element="nmsm export", expected="--loads LOADS.xml")
     if args.loads and not args.treatment:
         raise InputError("--loads needs --treatment", element="nmsm export", expected="--treatment RESULTS_DIR")
+    if args.trial and not args.treatment:
+        raise InputError("--trial names a trial of --treatment's results", element="nmsm export",
+                         expected="--trial with --treatment RESULTS_DIR")
     files, folders = _export_inputs(args)
     xml = Path(args.loads).with_suffix(".xml") if args.loads else None
     data = xml.with_suffix(".mot") if xml else None

@@ -35,6 +35,9 @@ def _check_arguments(args: argparse.Namespace) -> None:
     if bool(args.data_dir) == bool(args.motion):
         raise InputError("give exactly one of --data-dir and --motion", element="nmsm surrogate",
                          expected="a surrogate data folder or a reference motion")
+    if args.write_samples and not args.motion:
+        raise InputError("--write-samples keeps the poses sampled around a --motion; with --data-dir there are "
+                         "none to write", element="nmsm surrogate", expected="--write-samples with --motion only")
 
 
 def _check_samples_folder(args: argparse.Namespace, inputs: dict[Path, str]) -> None:
