@@ -21,9 +21,9 @@ import attrs
 import numpy as np
 
 from nmsm.errors import InputError
+from nmsm.io.motion_units import warn_implausible_angles
 from nmsm.io.storage import Table, read_storage
 from nmsm.model.components import GROUND, Model
-from nmsm.io.motion_units import warn_implausible_angles
 
 #: largest time difference (s) between a motion frame and its ground-reaction row
 TIME_MATCH_TOLERANCE = 5e-3

@@ -21,6 +21,7 @@ import attrs
 import numpy as np
 
 from nmsm.errors import InputError
+from nmsm.io.motion_units import warn_implausible_angles
 from nmsm.io.storage import COP_SUFFIXES, Table, read_storage
 from nmsm.io.trials import find_trial_file
 from nmsm.tools.treatment.model_interface import TreatmentModel
@@ -75,8 +76,12 @@ def _optional_trial_table(folder: Path, trial: str, starts: dict[str, float] | N
     return _shift(read_storage(path, **kwargs), starts)
 
 
-def _kinematics(table: Table, model: TreatmentModel) -> Table:
+def _kinematics(table: Table, model: TreatmentModel, *, positions: bool = True) -> Table:
+    """``table``'s rotational coordinates in radians; for a table of positions (IK, states) a
+    header whose unit looks wrong warns (:mod:`nmsm.io.motion_units`)."""
     rotational = {c for c in model.coordinate_names if model.is_rotational(c)}
+    if positions:
+        warn_implausible_angles(table, rotational)
     return table.to_radians(rotational)
 
 
@@ -120,7 +125,7 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
             if path is not None:
                 table = _shift(read_storage(path), starts)
                 if kind in ("states", "accelerations") and table.in_degrees:
-                    table = _kinematics(table, model)
+                    table = _kinematics(table, model, positions=kind == "states")
                 results[kind] = table
     weights_path = initial_dir / "synergyWeights.sto"
     synergy_weights = read_storage(weights_path) if weights_path.is_file() else None

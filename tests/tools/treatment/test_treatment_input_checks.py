@@ -226,3 +226,21 @@ def test_nmsm_run_prints_each_upgrade_warning_once(shared_data: Path) -> None:
         run_settings_file(settings, evaluate_only=True)
     counts = collections.Counter(str(w.message) for w in record if str(settings) in str(w.message))
     assert counts and max(counts.values()) == 1, counts
+
+
+# ----- the tracked IK's unit header ----------------------------------------------------------------
+@pytest.mark.shared_data
+def test_tracked_motion_whose_degrees_header_looks_wrong_warns(shared_data: Path, tmp_path: Path) -> None:
+    source = shared_data / "treatment" / "toy_arm" / "tracking_optimization" / "preprocessed"
+    data = tmp_path / "data"
+    for kind in ("IKData", "IDData"):
+        (data / kind).mkdir(parents=True)
+        (data / kind / "arm1.sto").write_text((source / kind / "arm1.sto").read_text())
+    path = _toy(shared_data, tmp_path, data=data)
+    assert not [m for m in _warnings(path) if "header may be wrong" in m]  # the tutorial's own file: silent
+    ik = data / "IKData" / "arm1.sto"
+    table = read_storage(ik)
+    degrees = {label: table.column(label) * 180 / 3.141592653589793 for label in table.labels}
+    write_storage(ik, table_from_columns(table.time, degrees))  # degrees written, header still radians
+    messages = sorted({m for m in _warnings(path) if "header may be wrong" in m})  # read as tracked and as guess
+    assert len(messages) == 1 and str(ik) in messages[0] and "r_elbow_flex" in messages[0]
