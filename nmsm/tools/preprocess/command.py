@@ -14,7 +14,7 @@ Before anything is processed (:func:`check_request`):
 Then :func:`.run.preprocess` writes into a hidden staging folder inside the output folder;
 the earlier-files check is repeated on the files actually made (a computed muscle analysis'
 file names are known only then) and the files are moved into the output folder. An error at
-any point leaves the output folder as it was (:func:`.output.staged_output`).
+any point leaves the output folder as it was (:meth:`nmsm.core.results.ResultsDirectory.task`).
 """
 
 from __future__ import annotations
@@ -26,10 +26,10 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError
 from nmsm.tools.preprocess import analyses
-from nmsm.tools.preprocess.output import (check_not_input_folder, commit, refuse_earlier_trials, staged_files,
-                                          staged_output)
+from nmsm.tools.preprocess.output import check_not_input_folder, refuse_earlier_trials
 from nmsm.tools.preprocess.run import PreprocessRequest, preprocess, select_channels
 from nmsm.tools.preprocess.signals import check_covers
 from nmsm.tools.preprocess.tables import read_table
@@ -145,10 +145,10 @@ def run_checked(request: PreprocessRequest) -> list[str]:
     (module docstring); returns the trial names."""
     out = Path(request.output)
     names = check_request(request)
-    with staged_output(out) as stage:
+    with ResultsDirectory(out).task("preprocess") as stage:
         preprocess(attrs.evolve(request, output=stage))
-        refuse_earlier_trials(out, names, [f for f in staged_files(stage) if not f.startswith("intermediate/")])
-        commit(stage, out)
+        written = sorted(p.relative_to(stage).as_posix() for p in stage.rglob("*") if p.is_file())
+        refuse_earlier_trials(out, names, [f for f in written if not f.startswith("intermediate/")])
     return names
 
 

@@ -9,28 +9,18 @@
   :class:`InputError` listing them; otherwise the tools reading the folder would combine
   one run's IK with another run's ID or muscle analysis (of another time window). Files of
   the trial are those :func:`nmsm.io.trials.contains_trial` finds.
-* :func:`staged_output`: everything is written into a hidden staging folder inside the
-  output folder, moved into place only when the whole run succeeded (after the exact check
-  of earlier files); an error removes the staging folder, and the output folder when the
-  run created it.
+
+Staging (all or nothing) is :meth:`nmsm.core.results.ResultsDirectory.task`'s, as for every tool.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
-import shutil
-import tempfile
-from collections.abc import Collection, Iterable, Iterator, Mapping
+from collections.abc import Collection, Iterable, Mapping
 from pathlib import Path
 
 from nmsm.errors import InputError
 from nmsm.io.layout import TRIAL_FOLDERS  # the trial folders a run writes (MAData: <trial>/ folders)
 from nmsm.io.trials import contains_trial
-
-#: prefix of the staging folder inside the output folder
-STAGING_PREFIX = ".preprocess-partial-"
-
 
 def check_not_input_folder(output: Path, inputs: Mapping[str, Path | None],
                            folders: Mapping[str, Path | None] | None = None) -> None:
@@ -84,50 +74,4 @@ def refuse_earlier_trials(output: Path, names: Collection[str], written: Collect
                      expected="a new output folder, or one without those files (move or remove them first)")
 
 
-def _missing_ancestors(path: Path) -> list[Path]:
-    """``path`` and its parents that do not exist yet, deepest first."""
-    missing = []
-    current = path.absolute()
-    while not current.exists():
-        missing.append(current)
-        current = current.parent
-    return missing
-
-
-@contextlib.contextmanager
-def staged_output(output: Path) -> Iterator[Path]:
-    """A staging folder inside ``output`` (created if needed); removed at the end. On an
-    error the output folder is removed again if this call created it (and it is empty)."""
-    created = _missing_ancestors(output)
-    output.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=output))
-    try:
-        yield stage
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        for folder in created:
-            with contextlib.suppress(OSError):
-                folder.rmdir()
-        raise
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
-
-
-def staged_files(stage: Path) -> list[str]:
-    """Files written in ``stage`` (relative, ``/``-separated, sorted)."""
-    return sorted(p.relative_to(stage).as_posix() for p in stage.rglob("*") if p.is_file())
-
-
-def commit(stage: Path, output: Path) -> list[Path]:
-    """Move every file of ``stage`` to the same place in ``output`` (replacing files there)."""
-    moved = []
-    for relative in staged_files(stage):
-        target = output / relative
-        target.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(stage / relative, target)
-        moved.append(target)
-    return moved
-
-
-__all__ = ["STAGING_PREFIX", "TRIAL_FOLDERS", "check_not_input_folder", "commit", "earlier_trial_files",
-           "refuse_earlier_trials", "staged_files", "staged_output"]
+__all__ = ["TRIAL_FOLDERS", "check_not_input_folder", "earlier_trial_files", "refuse_earlier_trials"]
