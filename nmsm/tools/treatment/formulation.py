@@ -23,8 +23,9 @@ import numpy as np
 
 from nmsm.core.problem import OptimizationProblem
 from nmsm.core.term import CostTerm, Term
-from nmsm.tools.treatment.context import TreatmentContext, _Quantities
+from nmsm.tools.treatment.context import TreatmentContext
 from nmsm.tools.treatment.problem_data import TreatmentData
+from nmsm.tools.treatment.quantities import ContextQuantities
 from nmsm.tools.treatment.transcription.base import Block, FinalTime, Phase, Trajectory, Transcription
 from nmsm.tools.treatment.transcription.lgr import RadauCollocation
 from nmsm.tools.treatment.transcription.mesh import Mesh
@@ -146,7 +147,7 @@ def build_problem(
         controller.declare(problem)
     if declare_extra is not None:
         declare_extra(problem, data)
-    context = TreatmentContext(_Quantities(data, trajectory, parallel=parallel))
+    context = TreatmentContext(ContextQuantities(data, trajectory, parallel=parallel))
     weights = term_weights(terms, normalize_cost_by_term_type)
     for term in terms:
         problem.add_term(term, context, weight=weights.get(id(term), 1.0))
