@@ -13,7 +13,11 @@ A stage kind is identified by its settings tool element. It declares:
 * ``run``: ``"module:function"`` called as ``function(settings_file, **options)``;
 * ``validate``: optional ``"module:function"`` called with the parsed settings before
   anything runs (:mod:`nmsm.tools.pipeline.validation`: term types, solver settings), beyond
-  what the settings class itself checks.
+  what the settings class itself checks;
+* ``bind``: optional ``"module:function"`` that ``--check`` calls with the parsed settings to
+  bind the stage's cost and constraint terms to its model and data without solving
+  (:func:`nmsm.tools.pipeline.validation.bind_treatment`); ``has_terms``: the stage has terms
+  (without ``bind``, ``--check`` says they are bound when the stage runs).
 
 ================  ================================  =====  =========================================
 code              tool element                      order  produces
@@ -79,6 +83,8 @@ class StageKind:
     hook: str | Callable[..., Any] | None = None  #: (StageSettings, Artifacts, kept keys) -> {key: source}
     run_options: Mapping[str, Any] = attrs.field(factory=dict)
     validate: str | Callable[[Any], None] | None = None  #: checks of the parsed settings (module docstring)
+    bind: str | Callable[[Any], None] | None = None  #: binds the parsed settings' terms (module docstring)
+    has_terms: bool = False  #: the settings hold cost or constraint terms
 
     def load_settings_class(self) -> type:
         return _load(self.settings_class)
@@ -91,6 +97,9 @@ class StageKind:
 
     def load_validate(self) -> Callable[[Any], None] | None:
         return None if self.validate is None else _load(self.validate)
+
+    def load_bind(self) -> Callable[[Any], None] | None:
+        return None if self.bind is None else _load(self.bind)
 
     def load_hook(self) -> Callable[..., Any] | None:
         return None if self.hook is None else _load(self.hook)
@@ -119,7 +128,7 @@ _BUILT_IN = (
     StageKind("jmp", "Joint Model Personalization", "JointModelPersonalizationTool", 10,
               "nmsm.io.settings.jmp:JointModelPersonalizationSettings", "nmsm.tools.jmp.run:run_settings",
               _OUT + "jmp_outputs", requires=("model",), produces=("model",),
-              wires=(Wire("model", "input_model_file"),), run_options={"quiet": True}),
+              wires=(Wire("model", "input_model_file"),), run_options={"quiet": True}, has_terms=True),
     StageKind("analysis", "IK, ID and muscle analysis on the current model", "ModelAnalysisTool", 20,
               "nmsm.tools.pipeline.analysis_settings:ModelAnalysisSettings",
               "nmsm.tools.pipeline.analysis:run_settings", _OUT + "analysis_outputs",
@@ -132,19 +141,20 @@ _BUILT_IN = (
     StageKind("mtp", "Muscle-Tendon Personalization", "MuscleTendonPersonalizationTool", 40,
               "nmsm.io.settings.mtp:MuscleTendonPersonalizationSettings", "nmsm.tools.mtp.run:run_settings",
               _OUT + "mtp_outputs", requires=("model", "data_directory"), uses=("osimx",),
-              produces=("osimx", "mtp_results"), wires=_PERSONALIZATION_WIRES, validate=_CHECK + "mtp"),
+              produces=("osimx", "mtp_results"), wires=_PERSONALIZATION_WIRES, validate=_CHECK + "mtp",
+              has_terms=True),
     StageKind("ncp", "Neural Control Personalization", "NeuralControlPersonalizationTool", 50,
               "nmsm.io.settings.ncp:NeuralControlPersonalizationSettings", "nmsm.tools.ncp.run:run_settings",
               _OUT + "ncp_outputs", requires=("model", "data_directory"), uses=("osimx", "mtp_results"),
               produces=("osimx", "ncp_results"),
               wires=(*_PERSONALIZATION_WIRES, Wire("mtp_results", "mtp_results_directory")),
-              run_options={"print_level": 0}, validate=_CHECK + "ncp"),
+              run_options={"print_level": 0}, validate=_CHECK + "ncp", has_terms=True),
     StageKind("gcp", "Ground Contact Personalization", "GroundContactPersonalizationTool", 60,
               "nmsm.io.settings.gcp:GroundContactPersonalizationSettings", "nmsm.tools.gcp.run:run_settings",
               _OUT + "gcp_outputs", requires=("model", "data_directory"), uses=("osimx",),
               produces=("osimx", "gcp_results"),
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
-                     Wire("data_directory", "input_directory")), validate=_CHECK + "gcp"),
+                     Wire("data_directory", "input_directory")), validate=_CHECK + "gcp", has_terms=True),
     StageKind("surrogate", "Surrogate muscle-geometry data", "SurrogateDataTool", 70,
               "nmsm.tools.pipeline.surrogate_settings:SurrogateDataSettings",
               "nmsm.tools.pipeline.surrogate_stage:run_settings", _OUT + "surrogate_outputs",
@@ -158,7 +168,8 @@ _BUILT_IN = (
                      Wire("data_directory", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
               hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", run_options={"print_level": 0},
-              validate=_CHECK + "treatment"),
+              validate=_CHECK + "treatment", bind=_CHECK + "bind_treatment",
+              has_terms=True),
     StageKind("vo", "Verification Optimization", "VerificationOptimizationTool", 90,
               _TREATMENT_SETTINGS + "VerificationOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -167,7 +178,8 @@ _BUILT_IN = (
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              run_options={"print_level": 0}, validate=_CHECK + "treatment"),
+              run_options={"print_level": 0}, validate=_CHECK + "treatment", bind=_CHECK + "bind_treatment",
+              has_terms=True),
     StageKind("do", "Design Optimization", "DesignOptimizationTool", 100,
               _TREATMENT_SETTINGS + "DesignOptimizationSettings", "nmsm.tools.treatment.run:run_settings",
               _OUT + "treatment_outputs", requires=("model", "treatment_results"),
@@ -176,7 +188,8 @@ _BUILT_IN = (
                      Wire("treatment_results", "initial_guess_directory"),
                      Wire("treatment_results", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              run_options={"print_level": 0}, validate=_CHECK + "treatment"),
+              run_options={"print_level": 0}, validate=_CHECK + "treatment", bind=_CHECK + "bind_treatment",
+              has_terms=True),
 )
 
 _REGISTRY: dict[str, StageKind] = {kind.tool_element: kind for kind in _BUILT_IN}

@@ -54,14 +54,14 @@ from typing import Any
 import attrs
 from lxml import etree
 
-from nmsm.errors import InputError
+from nmsm.errors import InputError, NmsmError
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS, Artifacts
 from nmsm.tools.pipeline.hashing import DigestCache, code_digest
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
 from nmsm.tools.pipeline.plan import check_inputs, check_order
 from nmsm.tools.pipeline.stage_settings import StageSettings
 from nmsm.tools.pipeline.state import MARKER, VERSION, PipelineState, StageRecord, has_marker, write_marker
-from nmsm.tools.pipeline.validation import validate_stage
+from nmsm.tools.pipeline.validation import bind_stage, validate_stage
 from nmsm.tools.pipeline.wiring import wire_stage
 
 PIPELINE_COPY = "pipeline.xml"
@@ -185,8 +185,11 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     ``only``: run just these stages (the others must be up to date when a selected stage
     needs their outputs); ``until``: stop after this stage; ``rebuild``: redo every stage;
     ``force``: redo these stages; ``check_only``: validate (every selected stage's settings
-    too) and report which stages would run and how they would be wired, without running or
-    writing anything. ``stage_options``: extra keyword arguments per stage
+    too), bind the terms of every stage that would run to its model and data
+    (:func:`nmsm.tools.pipeline.validation.bind_stage`; a stage whose inputs an earlier stage
+    of the run makes is bound when it runs, and the check says so) and report which stages
+    would run and how they would be wired, without running or writing anything; every
+    stage's errors are reported together. ``stage_options``: extra keyword arguments per stage
     name for its tool's ``run_settings``.
     """
     say = log or (lambda text: None)
@@ -201,19 +204,27 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     enabled = [s for s in spec.stages if s.enabled]
     check_inputs(spec, {s.name: s.load_settings() for s in enabled})
     selected = _selection(spec, only, until)
-    checked = validate_stages(spec, selected, quiet=not check_only, every_error=check_only)
+    errors: list[tuple[str, InputError]] = []  # check_only: (stage, error), every stage's
+    checked = validate_stages(spec, selected, quiet=not check_only, every_error=check_only,
+                              errors=errors if check_only else None)
     if check_only:
         say(f"settings checked: {', '.join(checked) or 'no stage selected'}")
     state = PipelineState.load(results, salvage=rebuild)
     protected = input_paths(spec, results)
     for stage in enabled:
         if stage.name in selected:
-            _check_stage_folder(spec, stage, results, state, protected, trust_markers=rebuild)
+            try:
+                _check_stage_folder(spec, stage, results, state, protected, trust_markers=rebuild)
+            except InputError as exc:
+                if not check_only:
+                    raise
+                errors.append((stage.name, exc))
     forced = set(force) | ({s.name for s in spec.stages} if rebuild else set())
     cache = DigestCache(exclude=[results])
     artifacts = Artifacts()
     unavailable: dict[str, str] = {}  # artifact -> stage that should have made it but did not run
     pending: set[str] = set()  # check_only: artifacts of stages that would run (wired, not made yet)
+    stand_ins: set[Path] = set()  # check_only: where those artifacts are assumed
     for name, path in spec.inputs.items():
         artifacts.provide(name, path, "the pipeline inputs")
     if not check_only:
@@ -250,9 +261,14 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
             outcomes.append(StageOutcome(stage.name, stage.kind.code, stage.kind.label, status, 0.0,
                                          settings_file, folder, {}, wired))
             say(f"{head}: {status}")
+            if status == "would run" and not any(name == stage.name for name, _ in errors):
+                error = _bind_terms(stage, settings, wired, artifacts, stand_ins, say)
+                if error is not None:
+                    errors.append((stage.name, error))
             for artifact in stage.kind.produces:
                 if stage.name in selected:  # --check: wired as in the run, made when the stage runs
                     artifacts.provide(artifact, _stand_in(results, stage, artifact), f"stage '{stage.name}'")
+                    stand_ins.add(_stand_in(results, stage, artifact))
                     pending.add(artifact)
                     continue
                 artifacts.items.pop(artifact, None)
@@ -269,6 +285,9 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
             unavailable.pop(artifact, None)
         outcomes.append(outcome)
         say(f"{head}: finished in {outcome.wall_time:.1f} s")
+    if errors:
+        order = [s.name for s in spec.stages]
+        _raise_all([exc for _, exc in sorted(errors, key=lambda item: order.index(item[0]))])
     run = PipelineRun(spec, results, tuple(outcomes), time.perf_counter() - start)
     if not check_only:
         (results / SUMMARY_FILE).write_text(run.summary() + "\n")
@@ -280,19 +299,58 @@ def _stand_in(results: Path, stage: StageSpec, artifact: str) -> Path:
     return _stage_folder(results, stage).resolve() / f".{artifact}"
 
 
+def _bind_terms(stage: StageSpec, settings: StageSettings, wired: dict[str, str], artifacts: Artifacts,
+                stand_ins: set[Path], say: Callable[[str], None]) -> InputError | None:
+    """``--check``: bind the terms of a stage that would run (:func:`bind_stage`), or say why
+    they are bound only when it runs; the binding error, naming the stage, else ``None``."""
+    kind = stage.kind
+    if not kind.has_terms and kind.bind is None:
+        return None
+    for key, source in wired.items():
+        artifact = artifacts.get(source.split(" from ", 1)[0])
+        if artifact is not None and artifact.path in stand_ins:
+            say(f"      terms of stage '{stage.name}' are bound when it runs: its <{key.rsplit('/', 1)[-1]}> comes "
+                f"from {artifact.source}")
+            return None
+    if kind.bind is None:
+        say(f"      terms of stage '{stage.name}' are bound when it runs: {kind.label} binds them to the problem "
+            "it builds from its data")
+        return None
+    try:
+        bind_stage(stage, settings)
+    except NmsmError as exc:
+        if isinstance(exc, InputError):
+            return InputError(f"stage '{stage.name}' ({kind.code}), binding its terms to its model and data: "
+                              f"{exc.detail}", file=exc.file, line=exc.line, element=exc.element,
+                              expected=exc.expected)
+        return InputError(f"stage '{stage.name}' ({kind.code}), binding its terms to its model and data: {exc}",
+                          file=stage.settings_file or stage.file)
+    say(f"      terms of stage '{stage.name}' bound to its model and data")
+    return None
+
+
+def _raise_all(errors: Sequence[InputError]) -> None:
+    """Raise the one error, or one listing them all."""
+    if len(errors) == 1:
+        raise errors[0]
+    if errors:
+        raise InputError(f"the settings of {len(errors)} stages have errors:\n  " + "\n  ".join(map(str, errors)))
+
+
 def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = True, every_error: bool = False,
-                    ) -> list[str]:
+                    errors: list[tuple[str, InputError]] | None = None) -> list[str]:
     """Validate the settings of every enabled stage in ``selected`` as the runner will hand
     them to the tool (:mod:`nmsm.tools.pipeline.validation`), earlier stages' outputs wired
     as stand-ins; :class:`InputError` at the user's settings file and line (``every_error``:
-    one error listing every stage's first error, when several stages have one). Returns the
-    names of the stages checked. Nothing is read from or written into the results tree."""
+    one error listing every stage's first error, when several stages have one; ``errors``:
+    append ``(stage, error)`` there instead of raising). Returns the names of the stages
+    checked. Nothing is read from or written into the results tree."""
     results = spec.results_directory
     artifacts = Artifacts()
     for name, path in spec.inputs.items():
         artifacts.provide(name, path, "the pipeline inputs")
     checked: list[str] = []
-    errors: list[InputError] = []
+    found: list[tuple[str, InputError]] = [] if errors is None else errors
     for stage in spec.stages:
         if not stage.enabled:
             continue
@@ -301,16 +359,14 @@ def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = Tru
             try:
                 validate_stage(stage, settings, quiet=quiet)
             except InputError as exc:
-                if not every_error:
+                if not every_error and errors is None:
                     raise
-                errors.append(exc)
+                found.append((stage.name, exc))
             checked.append(stage.name)
         for artifact in stage.kind.produces:
             artifacts.provide(artifact, _stand_in(results, stage, artifact), f"stage '{stage.name}'")
-    if len(errors) == 1:
-        raise errors[0]
-    if errors:
-        raise InputError(f"the settings of {len(errors)} stages have errors:\n  " + "\n  ".join(map(str, errors)))
+    if errors is None:
+        _raise_all([exc for _, exc in found])
     return checked
 
 

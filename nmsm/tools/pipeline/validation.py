@@ -17,6 +17,17 @@ settings: the built-in ones below build every enabled cost and constraint term f
 term registry for the tool that will evaluate it (unknown and disallowed term types,
 unreadable term fields), and
 for TO/VO/DO read the solver settings file and the DO's model functions.
+
+``nmsm pipeline --check`` also *binds* the terms of every stage that would run
+(:func:`bind_stage`, the kind's ``bind`` function): each term is checked against the
+stage's model and data as the tool checks it before solving (a coordinate, load, muscle,
+control or marker the model or controllers lack; a plugin term's own ``bind``), without
+solving and without OpenSim. For TO, VO and DO (:func:`bind_treatment`) that is the tool's
+own :func:`~nmsm.tools.treatment.tool.prepare`: model, data files, controllers, then every
+term bound while the problem is assembled (1-3 s a stage). A stage whose model or data an
+earlier stage of the run makes is bound when it runs (the runner says so); JMP, MTP, NCP and
+GCP bind their terms to the problem they build from their data (MTP after its length
+initialization), so their terms are bound when they run too.
 """
 
 from __future__ import annotations
@@ -51,6 +62,18 @@ def validate_stage(stage: StageSpec, settings: StageSettings, *, quiet: bool = T
         check = stage.kind.load_validate()
         if check is not None:
             check(parsed)
+
+
+def bind_stage(stage: StageSpec, settings: StageSettings) -> None:
+    """Bind the stage's terms to its model and data (its kind's ``bind``, module docstring);
+    :class:`InputError` (or the term's :class:`~nmsm.errors.NmsmError`) at the term's
+    settings file and line. Warnings are hidden (the tool repeats them when it runs)."""
+    bind = stage.kind.load_bind()
+    if bind is None:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bind(parse_settings(settings))
 
 
 # ---- the built-in kinds' checks ----------------------------------------------------------------
@@ -104,3 +127,20 @@ def treatment(settings: Any) -> None:
         from nmsm.tools.treatment.design import model_modifiers
 
         model_modifiers(settings)
+
+
+def bind_treatment(settings: Any) -> None:
+    """TO, VO, DO: the tool's own preparation (model, data, controllers; every term bound
+    while the problem is assembled), not solved."""
+    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.solver import OptimalControlSolverSettings
+    from nmsm.tools.treatment.tool import TreatmentOptions, prepare
+
+    solver = OptimalControlSolverSettings.from_document(
+        read_settings_document(settings.optimal_control_solver_settings_file))
+    declare_extra = None
+    if settings.tool_code == "DO":
+        from nmsm.tools.treatment.design import design_extras
+
+        declare_extra = design_extras(settings)
+    prepare(settings, solver, TreatmentOptions(parallel=1), declare_extra=declare_extra)

@@ -105,3 +105,47 @@ def test_stage_settings_are_checked_before_anything_runs_or_is_emptied(
     assert str(info.value).startswith(f"{do}:{_type_line(do)}: <type>: unknown cost 'controler_tracking'")
     assert "results/do.xml" not in str(info.value)
     assert _tree(kick / "results") == before
+
+
+def _term_line(settings: Path, text: str) -> int:
+    """The line of the first ``text`` after the settings' first <RCNLCostTerm>."""
+    lines = settings.read_text().splitlines()
+    term = next(k for k, line in enumerate(lines) if "<RCNLCostTerm" in line)
+    return next(k for k in range(term, len(lines)) if text in lines[k]) + 1
+
+
+def test_check_binds_the_terms_to_the_model(kick: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--check binds each stage's terms to its model and data without solving: a tracked
+    coordinate the model lacks is named with the stage, settings file, line and element; a
+    stage whose data an earlier stage makes is said to be bound when it runs; every stage's
+    errors are reported together; nothing is written."""
+    pipeline, to, do = kick / "pipeline.xml", kick / "TO.xml", kick / "DO.xml"
+    good = to.read_text()
+    cost = "<coordinate_list>hip_flexion_r knee_angle_r ankle_angle_r</coordinate_list>"
+    line = _term_line(to, cost)
+    lines = good.splitlines(keepends=True)
+    lines[line - 1] = lines[line - 1].replace("knee_angle_r ", "knee_angel_r ")
+    to.write_text("".join(lines))
+    assert main(["pipeline", "--check", str(pipeline)]) == 1
+    captured = capsys.readouterr()
+    err = captured.err
+    assert err.startswith(f"nmsm: error: {to}:{line}: <coordinate_list>: stage 'to' (to), binding its terms to its "
+                          "model and data: term 'generalized_coordinate_tracking'"), err
+    assert "coordinate 'knee_angel_r' is not in the model (expected one of pelvis_tilt," in err
+    assert "terms of stage 'vo' are bound when it runs: its <initial_guess_directory> comes from stage 'to'" \
+        in captured.out
+    assert "terms of stage 'do' are bound when it runs" in captured.out
+    assert "Traceback" not in err and not (kick / "results").exists()
+    # with another stage's settings error, both are reported
+    do.write_text(do.read_text().replace(*TYPO))
+    assert main(["pipeline", "--check", str(pipeline)]) == 1
+    err = capsys.readouterr().err
+    assert "the settings of 2 stages have errors" in err
+    assert f"{to}:{line}: <coordinate_list>: stage 'to'" in err and "'knee_angel_r'" in err
+    assert f"{do}:{_type_line(do)}: <type>: unknown cost 'controler_tracking'" in err
+    # fixed: the terms bind, and the check passes
+    to.write_text(good)
+    do.write_text(do.read_text().replace(TYPO[1], TYPO[0]))
+    assert main(["pipeline", "--check", str(pipeline)]) == 0
+    assert "terms of stage 'to' bound to its model and data" in capsys.readouterr().out
+    assert not (kick / "results").exists()
