@@ -17,7 +17,17 @@ Per full-length trial ``<name>`` and each time window ``k`` (output trial ``<nam
   ``pad = ceil(emg_padding_time / dt)`` rows of ``dt = window / (rows - 1)`` each side, the
   spline's small undershoots below 0 set to 0.
 
-Rotational IK columns are written in degrees (``inDegrees=yes``) as the input was.
+Rotational IK columns are written in degrees (``inDegrees=yes``) as the input was; the IK
+header is checked against the model's rotational coordinates (a wrong ``inDegrees`` warns).
+
+Each time window of a full-length trial becomes a
+:class:`~nmsm.tools.preprocess.run.PreprocessRequest` (so each window keeps its own EMG
+padding), and
+all of them go through ``nmsm preprocess``'s checked path
+(:func:`nmsm.tools.preprocess.command.run_checked`): every trial's files are read and
+checked (each covers the trial's time ranges, the output folder holds no input, no earlier
+run's files of the trials) before anything is processed, then the trials are written staged,
+all or nothing. Errors name the settings file and element (or the data file at fault).
 """
 
 from __future__ import annotations
@@ -34,9 +44,8 @@ from nmsm.errors import InputError
 from nmsm.io.storage import Table
 from nmsm.tools.pipeline.native import read_native_settings
 from nmsm.tools.pipeline.preprocess_settings import TOOL, DataPreprocessingSettings, PreprocessTrial
-from nmsm.tools.preprocess.run import EmgOptions, process_emg_table
-from nmsm.tools.preprocess.tables import read_table
-from nmsm.tools.preprocess.trials import TrialSources, split_into_trials
+from nmsm.tools.preprocess.command import run_checked
+from nmsm.tools.preprocess.run import EmgOptions, PreprocessRequest, process_emg_table
 
 
 def read_settings(path: str | os.PathLike[str]) -> DataPreprocessingSettings:
@@ -48,21 +57,43 @@ def process_emg(table: Table, high_pass: float, low_pass: float, order: int) -> 
     return process_emg_table(table, EmgOptions(order, high_pass, low_pass, demean="channel")).data
 
 
-def _sources(settings: DataPreprocessingSettings, trial: PreprocessTrial) -> TrialSources:
+def _elements(trial: PreprocessTrial) -> dict[str, str]:
+    """``nmsm preprocess`` options -> the settings elements that give them for ``trial``."""
+    at = f'<Trial name="{trial.name}">'
+    return {"--output": "<results_directory>", "--time-pair": f"{at} <time_ranges>", "--prefix": at,
+            "--rows": "<rows_per_trial>", "--cutoff": "<cutoff_frequency>", "--model": "<input_model_file>",
+            "--emg-padding-time": "<emg_padding_time>", "--ik/--markers": f"{at} (IKData)"}
+
+
+def requests(settings: DataPreprocessingSettings, settings_file: Path) -> list[PreprocessRequest]:
+    """One checked-path request per time window of each full-length trial (module docstring);
+    :class:`InputError`
+    for a trial with neither an IK nor an ID file."""
     source = settings.motion_data_directory
+    out: list[PreprocessRequest] = []
+    for trial in settings.trials:
+        def found(folder: str) -> Path | None:
+            path = source / folder / f"{trial.name}.sto"
+            return path if path.is_file() else None
 
-    def found(folder: str) -> Path | None:
-        path = source / folder / f"{trial.name}.sto"
-        return path if path.is_file() else None
-
-    emg = found("EMGData")
-    if emg is not None:
-        options = EmgOptions(settings.filter_order, settings.emg_high_pass_frequency, settings.emg_low_pass_frequency,
-                             demean=settings.emg_demean)
-        emg = process_emg_table(read_table(emg), options)
-    ma = source / "MAData" / trial.name
-    return TrialSources(ik=found("IKData"), inverse_dynamics=found("IDData"), grf=found("GRFData"), emg=emg,
-                        muscle_analysis=ma if ma.is_dir() else None)
+        if found("IKData") is None and found("IDData") is None:
+            raise InputError(f"no IKData or IDData file for trial '{trial.name}'", file=settings_file,
+                             element=f"<Trial name=\"{trial.name}\">",
+                             expected=f"{source}/IKData/{trial.name}.sto")
+        ma = source / "MAData" / trial.name
+        pairs = trial.time_ranges
+        for k in range(0, len(pairs), 2):  # one request a window: each window's own EMG padding
+            out.append(PreprocessRequest(
+                time_pairs=((pairs[k], pairs[k + 1]),), output=settings.results_directory,
+                model=settings.input_model_file, prefix=trial.name, names=(f"{trial.name}_{k // 2 + 1}",),
+                rows=settings.rows_per_trial, cutoff=settings.cutoff_frequency, raw_emg=found("EMGData"),
+                emg=EmgOptions(settings.filter_order, settings.emg_high_pass_frequency,
+                               settings.emg_low_pass_frequency, demean=settings.emg_demean),
+                emg_padding_time=settings.emg_padding_time, ik=found("IKData"), inverse_dynamics=found("IDData"),
+                grf=found("GRFData"), muscle_analysis=ma if ma.is_dir() else None,
+                filter_order=settings.filter_order, ik_radians=False, clip_emg=True, settings_file=settings_file,
+                elements=_elements(trial)))
+    return out
 
 
 def run_settings(settings_file: str | os.PathLike[str], *, results_directory: str | os.PathLike[str] | None = None,
@@ -72,21 +103,7 @@ def run_settings(settings_file: str | os.PathLike[str], *, results_directory: st
     settings = read_settings(settings_file)
     if results_directory is not None:
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
+    run_checked(requests(settings, Path(settings_file)), keep_intermediate=False)
     results = ResultsDirectory(settings.results_directory)
-    for trial in settings.trials:
-        if not (settings.motion_data_directory / "IKData" / f"{trial.name}.sto").is_file() and not (
-                settings.motion_data_directory / "IDData" / f"{trial.name}.sto").is_file():
-            raise InputError(f"no IKData or IDData file for trial '{trial.name}'", file=settings_file,
-                             element=f"<Trial name=\"{trial.name}\">",
-                             expected=f"{settings.motion_data_directory}/IKData/{trial.name}.sto")
-        sources = _sources(settings, trial)
-        pairs = trial.time_ranges
-        for k in range(0, len(pairs), 2):
-            name = f"{trial.name}_{k // 2 + 1}"
-            with results.task(name) as stage:
-                split_into_trials([(pairs[k], pairs[k + 1])], sources, stage, names=[name],
-                                  rows=settings.rows_per_trial, cutoff=settings.cutoff_frequency,
-                                  filter_order=settings.filter_order, emg_padding_time=settings.emg_padding_time,
-                                  ik_radians=False, clip_emg=True)
     results.copy_in(settings_file, f"settings_{Path(settings_file).name}")
     return results.path

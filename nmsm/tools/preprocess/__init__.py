@@ -7,8 +7,9 @@
 ``velocity``   muscle-tendon velocity from muscle-tendon length (``createMuscleTendonVelocity``)
 ``analyses``   IK / ID / MuscleAnalysis through nmsm's model core or OpenSim (bridge)
 ``run``        one recording -> trials
-``command``    what ``nmsm preprocess`` runs: arguments, output folder and inputs checked first, then
-               ``run`` into a staging folder (``output``: no input's folder, no mixing of runs)
+``command``    the one checked path (``nmsm preprocess``, ``run.preprocess``, the pipeline's stage):
+               arguments, output folder and inputs checked first, then ``run.process`` into a
+               staging folder (``output``: no input's folder, no mixing of runs)
 ``cli``        ``nmsm preprocess``
 
 Settings-file route: ``nmsm run`` on a ``<DataPreprocessingTool>`` file (the pipeline's

@@ -52,7 +52,7 @@ def _preprocess(args: argparse.Namespace) -> int:
         muscles=tuple(args.muscles.split()) if args.muscles else (),
         coordinates=tuple(args.coordinates.split()) if args.coordinates else (),
     )
-    names = run_checked(request)
+    names = run_checked([request])
     print(f"wrote {len(names)} trial(s) to {request.output}: {', '.join(names)}")
     return 0
 

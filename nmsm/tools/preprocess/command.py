@@ -1,5 +1,7 @@
-"""What ``nmsm preprocess`` runs: everything checked first, then :func:`.run.preprocess` into a
-staging folder, moved into place only when the whole run succeeded.
+"""The one checked path of preprocessing: everything checked first, then :func:`.run.process`
+into a staging folder, moved into place only when the whole run succeeded. ``nmsm
+preprocess``, :func:`.run.preprocess` and the pipeline's ``<DataPreprocessingTool>`` stage
+(several recordings into one folder) all run :func:`run_checked`.
 
 Before anything is processed (:func:`check_request`):
 
@@ -11,16 +13,22 @@ Before anything is processed (:func:`check_request`):
    markers and the IK settings' ``<time_range>`` for a computed IK; every muscle-analysis
    file), naming the file that falls short.
 
-Then :func:`.run.preprocess` writes into a hidden staging folder inside the output folder;
-the earlier-files check is repeated on the files actually made (a computed muscle analysis'
-file names are known only then) and the files are moved into the output folder. An error at
-any point leaves the output folder as it was (:meth:`nmsm.core.results.ResultsDirectory.task`).
+With several requests (recordings) every one is checked before any is processed, and their
+trial names must differ. Then :func:`.run.process` writes into a hidden staging folder
+inside the output folder; the earlier-files check is repeated on the files actually made (a
+computed muscle analysis' file names are known only then) and the files are moved into the
+output folder. An error at any point leaves the output folder as it was
+(:meth:`nmsm.core.results.ResultsDirectory.task`). An error of a request read from a
+settings file (``settings_file``) names that file and the element for the option
+(``elements``) unless it names a data file.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import shutil
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import attrs
@@ -30,7 +38,7 @@ from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError
 from nmsm.tools.preprocess import analyses
 from nmsm.tools.preprocess.output import check_not_input_folder, refuse_earlier_trials
-from nmsm.tools.preprocess.run import PreprocessRequest, preprocess, select_channels
+from nmsm.tools.preprocess.run import PreprocessRequest, process, select_channels
 from nmsm.tools.preprocess.signals import check_covers
 from nmsm.tools.preprocess.tables import read_table
 from nmsm.tools.preprocess.trials import check_time_pairs, emg_windows, ground_reaction_nan, ma_files
@@ -71,6 +79,12 @@ def trial_names(request: PreprocessRequest) -> list[str]:
         raise InputError("inverse dynamics needs a motion", element="--ik/--markers", expected="an IK file or markers")
     if request.compute_muscle_analysis and not has_motion:
         raise InputError("muscle analysis needs a motion", element="--ik/--markers", expected="an IK file or markers")
+    if request.names:
+        if len(request.names) != len(request.time_pairs) or any(not n or any(c in n for c in "/\\")
+                                                                 for n in request.names):
+            raise InputError(f"trial names {', '.join(request.names)} for {len(request.time_pairs)} time pair(s)",
+                             element="--prefix", expected="one plain file name per time pair")
+        return list(request.names)
     return [f"{request.prefix}_{k}" for k in range(1, len(request.time_pairs) + 1)]
 
 
@@ -140,13 +154,47 @@ def check_request(request: PreprocessRequest) -> list[str]:
     return names
 
 
-def run_checked(request: PreprocessRequest) -> list[str]:
-    """``nmsm preprocess``: :func:`check_request`, then :func:`.run.preprocess` staged
-    (module docstring); returns the trial names."""
-    out = Path(request.output)
-    names = check_request(request)
+@contextmanager
+def _named(request: PreprocessRequest) -> Iterator[None]:
+    """Errors without a file name the request's settings file and the element for the option."""
+    try:
+        yield
+    except InputError as exc:
+        if request.settings_file is not None and exc.file is None:
+            exc.file = str(request.settings_file)
+            exc.element = request.elements.get(exc.element or "", exc.element)
+            exc.args = (exc._compose(),)
+        raise
+
+
+def run_checked(requests: PreprocessRequest | Sequence[PreprocessRequest], *,
+                keep_intermediate: bool = True) -> list[str]:
+    """Check every request (:func:`check_request`), then process them staged into their
+    common output folder (module docstring); returns the trial names. ``keep_intermediate``:
+    keep ``intermediate/`` (with several requests, one subfolder per request's prefix)."""
+    requests = [requests] if isinstance(requests, PreprocessRequest) else list(requests)
+    if not requests:
+        raise ValueError("no preprocessing request")
+    out = Path(requests[0].output)
+    names: list[str] = []
+    for request in requests:
+        with _named(request):
+            if Path(request.output).resolve() != out.resolve():
+                raise InputError(f"output folder {request.output} differs from {out}", element="--output",
+                                 expected="one output folder for every recording")
+            made = check_request(request)
+            twice = sorted(set(made) & set(names))
+            if twice:
+                raise InputError(f"trial name(s) {', '.join(twice)} made twice", element="--prefix",
+                                 expected="recordings whose trial names differ")
+        names += made
     with ResultsDirectory(out).task("preprocess") as stage:
-        preprocess(attrs.evolve(request, output=stage))
+        for request in requests:
+            work = stage / "intermediate" / (trial_names(request)[0] if len(requests) > 1 else "")
+            with _named(request):
+                process(attrs.evolve(request, output=stage), work)
+        if not keep_intermediate:
+            shutil.rmtree(stage / "intermediate", ignore_errors=True)
         written = sorted(p.relative_to(stage).as_posix() for p in stage.rglob("*") if p.is_file())
         refuse_earlier_trials(out, names, [f for f in written if not f.startswith("intermediate/")])
     return names

@@ -11,13 +11,19 @@ Steps (tools.md §2), each optional:
 
 Intermediate files go to ``<output>/intermediate/``; trials to ``<output>/{IKData, IDData,
 EMGData, GRFData, MAData}``.
+
+:func:`preprocess` is the checked path every entry point takes (``nmsm preprocess``, the
+pipeline's ``<DataPreprocessingTool>`` stage and Python callers): the request is checked
+first, then processed into a staging folder that is moved into place only when everything
+succeeded (:func:`nmsm.tools.preprocess.command.run_checked`). :func:`process` is the
+unchecked processing step alone, writing straight into ``request.output``.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import attrs
@@ -75,6 +81,13 @@ class PreprocessRequest:
     compute_muscle_analysis: bool = False
     muscles: tuple[str, ...] = ()
     coordinates: tuple[str, ...] = ()
+    filter_order: int = 4  #: Butterworth order of the IK, ID and muscle-analysis low-pass
+    ik_radians: bool = True  #: write rotational IK in radians (False: keep the input's unit)
+    clip_emg: bool = False  #: set the EMG spline's undershoots below 0 to 0
+    names: tuple[str, ...] = ()  #: the trials' names, one per time pair (default ``<prefix>_<k>``)
+    settings_file: Path | None = None  #: settings file the request was read from (named in errors)
+    #: command-line option (``--rows``) -> the settings element that gave it, for errors
+    elements: Mapping[str, str] = attrs.field(factory=dict)
 
 
 def process_emg_table(table: Table, options: EmgOptions = EmgOptions()) -> Table:
@@ -130,9 +143,19 @@ def _with_velocity(folder: Path, work: Path) -> Path:
 
 
 def preprocess(request: PreprocessRequest) -> list[str]:
-    """Run the steps of the module docstring; returns the trial names."""
+    """Check ``request``, then run the steps of the module docstring staged (nothing is
+    written on bad input, nothing half-written is left on an error); returns the trial names."""
+    from nmsm.tools.preprocess.command import run_checked
+
+    return run_checked([request])
+
+
+def process(request: PreprocessRequest, work: Path | None = None) -> list[str]:
+    """The steps of the module docstring, unchecked, into ``request.output`` (intermediate
+    files into ``work``, default ``<output>/intermediate``); returns the trial names. Use
+    :func:`preprocess`, which checks the request first and stages the files."""
     out = Path(request.output)
-    work = out / "intermediate"
+    work = out / "intermediate" if work is None else work
     needs_model = request.markers is not None or request.compute_muscle_analysis or (
         request.inverse_dynamics is None and request.external_loads is not None)
     if needs_model and request.model is None:
@@ -164,8 +187,11 @@ def preprocess(request: PreprocessRequest) -> list[str]:
         ma = _with_velocity(Path(ma), work / "MuscleAnalysis")
     sources = TrialSources(ik=ik, inverse_dynamics=inverse_dynamics, grf=request.grf, emg=emg,
                            muscle_analysis=ma, rotational=_rotational(request.model) if ik is not None else ())
-    return split_into_trials(request.time_pairs, sources, out, prefix=request.prefix, rows=request.rows,
-                             cutoff=request.cutoff, emg_padding_time=request.emg_padding_time)
+    return split_into_trials(request.time_pairs, sources, out, prefix=request.prefix, names=request.names or None,
+                             rows=request.rows,
+                             cutoff=request.cutoff, filter_order=request.filter_order,
+                             emg_padding_time=request.emg_padding_time, ik_radians=request.ik_radians,
+                             clip_emg=request.clip_emg)
 
 
 def parse_time_pairs(texts: Sequence[str]) -> tuple[tuple[float, float], ...]:
@@ -185,5 +211,5 @@ def parse_time_pairs(texts: Sequence[str]) -> tuple[tuple[float, float], ...]:
     return tuple(pairs)
 
 
-__all__ = ["EmgOptions", "PreprocessRequest", "parse_time_pairs", "preprocess", "process_emg_table",
+__all__ = ["EmgOptions", "PreprocessRequest", "parse_time_pairs", "preprocess", "process", "process_emg_table",
            "process_raw_emg_file", "select_channels"]

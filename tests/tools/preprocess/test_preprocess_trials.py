@@ -205,7 +205,10 @@ def test_settings_file_route(tmp_path):
     _write(ma / "gait_Length.sto", t, {"soleus_r": 0.3 + 0.01 * np.sin(2 * t)})
     _write(ma / "gait_MomentArm_knee_angle_r.sto", t, {"soleus_r": 0.04 + 0 * t})
     create_velocity_file(ma / "gait_Length.sto")
-    (tmp_path / "model.osim").write_text("<OpenSimDocument/>")
+    from nmsm.examples.synthetic_jmp import leg_model_xml
+
+    # the stage reads the model: the IK header is checked against its rotational coordinates
+    (tmp_path / "model.osim").write_text(leg_model_xml().decode().replace('"knee_angle"', '"knee_angle_r"'))
     settings = tmp_path / "pre.xml"
     settings.write_text('<NMSMPipelineDocument Version="1.5.3"><DataPreprocessingTool>'
                         "<results_directory>out</results_directory><input_model_file>model.osim</input_model_file>"
