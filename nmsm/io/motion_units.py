@@ -14,7 +14,9 @@ its range in radians and degrees and the header, when
   radians (as degrees, the whole motion would stay within ±3.1°).
 
 It is used where motion files are read for a model: preprocessing's IK split, GCP's motion,
-JMP / IK coordinate-task files, and every motion matched to a model's coordinates by
+JMP / IK coordinate-task files, treatment optimization's tracked and guess motions, surrogate
+creation's reference motion (``nmsm surrogate --motion``) and data-folder ``IKData`` files,
+and every motion matched to a model's coordinates by
 :func:`nmsm.model.id_tool.check_motion_columns` (``nmsm id``, ``markers``, ``muscle-analysis``).
 """
 

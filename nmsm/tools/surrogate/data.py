@@ -7,19 +7,21 @@ Layout (the original's ``surrogate_model_data_directory``)::
     <data>/MAData/<trial>/*_MomentArm_<coord>.sto    moment arms (m), one per surrogate coordinate
 
 Rows of every trial are stacked. IK columns of rotational coordinates are converted
-from degrees when the file says ``inDegrees=yes``; length and moment-arm files are read
-as they are. Time columns must agree between a trial's files.
+from degrees when the file says ``inDegrees=yes`` (an IK file whose header looks wrong for
+the model warns: :mod:`nmsm.io.motion_units`); length and moment-arm files are read as they
+are. Time columns must agree between a trial's files.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Collection, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from nmsm.errors import InputError
+from nmsm.io.motion_units import Rotational, warn_implausible_angles
 from nmsm.io.storage import read_storage
 from nmsm.io.trials import find_file_by_suffix, find_trial_file, find_trial_folder, trial_prefixes
 from nmsm.model.surrogate import GeometrySamples
@@ -33,13 +35,17 @@ def read_trial_samples(
     data_directory: str | os.PathLike[str],
     trial: str,
     coordinates: Sequence[str],
-    rotational: Collection[str],
+    rotational: Rotational,
     muscles: Sequence[str] | None = None,
 ) -> GeometrySamples:
-    """One trial's samples (see the module docstring). ``muscles`` default: the Length file's columns."""
+    """One trial's samples (see the module docstring). ``rotational``: the model's rotational
+    coordinates, or name -> range (rad) for the unit check; ``muscles`` default: the Length
+    file's columns."""
     data = Path(data_directory)
     ik_file = find_trial_file(data / "IKData", trial)
-    ik = read_storage(ik_file).to_radians(rotational)
+    ik = read_storage(ik_file)
+    warn_implausible_angles(ik, rotational, file=ik_file)
+    ik = ik.to_radians(rotational)
     folder = find_trial_folder(data / "MAData", trial)
     length = read_storage(find_file_by_suffix(folder, "_Length"))
     names = tuple(length.labels if muscles is None else muscles)
@@ -63,7 +69,7 @@ def read_trial_samples(
 def read_samples(
     data_directory: str | os.PathLike[str],
     coordinates: Sequence[str],
-    rotational: Collection[str],
+    rotational: Rotational,
     trials: Sequence[str] | None = None,
     muscles: Sequence[str] | None = None,
 ) -> GeometrySamples:

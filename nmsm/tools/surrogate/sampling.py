@@ -59,12 +59,16 @@ def poses_around_motion(
     """Latin-hypercube poses around every frame of ``motion`` (model coordinates it names).
 
     Returns ``(coordinates, poses)``, ``poses`` ``(n_frames * samples_per_frame, n_c)`` in
-    rad/m. Degrees in the motion are converted for rotational coordinates. ``varied``:
-    the coordinates to sample (default all; see the module docstring).
+    rad/m. Degrees in the motion are converted for rotational coordinates; a motion whose
+    ``inDegrees`` header looks wrong for the model warns (:mod:`nmsm.io.motion_units`).
+    ``varied``: the coordinates to sample (default all; see the module docstring).
     """
+    from nmsm.io.motion_units import warn_implausible_angles
+
     info = model_geometry_info(model_file, bridge)
     names = info["coordinates"]
-    rotational = {n for n, r in zip(names, info["rotational"]) if r}
+    rotational = {n: (float(lo), float(hi)) for n, r, (lo, hi) in zip(names, info["rotational"], info["ranges"]) if r}
+    warn_implausible_angles(motion, rotational, file=motion.source)
     table = motion.to_radians(rotational)
     coords = tuple(c for c in table.labels if c in names)
     if not coords:

@@ -56,7 +56,7 @@ def fit_from_data_directory(
     check_model_names("coordinates", coordinates, model.coordinate_names, described)
     if muscles is not None:
         check_model_names("muscles", muscles, model.muscle_names, described)
-    rotational = {c.name for c in model.coordinates if c.is_rotational}
+    rotational = {c.name: c.range for c in model.coordinates if c.is_rotational}  # ranges: the IK unit check
     samples = read_samples(data_directory, coordinates, rotational, trials, muscles)
     meta = {"model_file": str(Path(model_file).resolve()), "data_directory": str(Path(data_directory).resolve()),
             "moment_arms": "MuscleAnalysis files"}

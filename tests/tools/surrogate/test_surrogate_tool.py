@@ -7,18 +7,21 @@ switches on and off over the held-out poses (checked through OpenSim).
 
 from __future__ import annotations
 
+import re
+import warnings
+
 import attrs
 import numpy as np
 import pytest
 
 from nmsm.cli import main as nmsm_main
 from nmsm.errors import InputError
-from nmsm.io.storage import read_storage
+from nmsm.io.storage import read_storage, write_storage
 from nmsm.model.surrogate import SurrogateModel, fit_surrogate_model
 from nmsm.tools.surrogate.data import read_samples
 from nmsm.tools.surrogate.sampling import opensim_samples, poses_around_motion
 from nmsm.tools.surrogate.settings import read_surrogate_settings
-from nmsm.tools.surrogate.tool import fit_from_data_directory, surrogate_from_settings
+from nmsm.tools.surrogate.tool import fit_from_data_directory, rotational_coordinates, surrogate_from_settings
 
 LENGTH_RMS_LIMIT = 0.5e-3
 ARM_RMS_LIMIT = 1.0e-3
@@ -148,3 +151,44 @@ def test_muscle_analysis_cli_writes_the_layout(shared_data, bridge, tmp_path, ca
     path = [ours.labels.index(m) for m in ("bflh_r", "soleus_r", "tibant_r")]
     assert np.abs(ours.data[:, path] - shared.data[:, path]).max() <= 5e-9 + 1e-12
     print(f"largest difference to the OpenSim 4.4 file: {np.abs(ours.data - shared.data).max():.2e} m")
+
+
+def _between(start: str, end: str) -> str:
+    """A pattern of a text that starts with ``start`` and ends with ``end`` (both literal)."""
+    return re.escape(start) + ".*" + re.escape(end)
+
+
+def test_motions_whose_degrees_header_looks_wrong_warn(shared_data, bridge, tmp_path) -> None:
+    """``nmsm surrogate`` checks the ``inDegrees`` header of the motions it reads for the
+    model, as the other tools do (nmsm/io/motion_units.py): the --motion it samples around
+    (radians marked ``inDegrees=yes``) and the data folder's IKData file (degrees marked
+    ``inDegrees=no``) each warn, naming the file; the tutorial's files stay silent."""
+    model_file = shared_data / KICK / "RightLegAndPelvis.osim"
+    motion_file = shared_data / KICK / "preprocessed/IKData/drive_kick1.sto"
+    data = shared_data / KICK / "surrogateData"
+    common = ["--model", str(model_file), "--coordinates", "knee_angle_r", "--degree", "1"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)
+        poses_around_motion(model_file, read_storage(motion_file), samples_per_frame=1, bridge=bridge)
+        fit_from_data_directory(model_file, data, ["knee_angle_r"], degree=1)
+    marked = tmp_path / "marked_degrees.sto"
+    marked.write_text(motion_file.read_text().replace("endheader", "inDegrees=yes\nendheader", 1))
+    expected = _between(f"{marked}: inDegrees=yes, but every rotational column as written lies within [-π, π]; ",
+                        " the numbers look like radians, the header may be wrong (inDegrees=no)")
+    with pytest.warns(UserWarning, match=expected):
+        assert nmsm_main(["surrogate", *common, "--motion", str(marked), "--samples-per-frame", "1",
+                          "-o", str(tmp_path / "from_motion.json")]) == 0
+    folder = tmp_path / "surrogateData"
+    (folder / "IKData").mkdir(parents=True)
+    (folder / "MAData").symlink_to(data / "MAData", target_is_directory=True)
+    radians = read_storage(data / "IKData" / "drive_kick1.sto")
+    rotational = rotational_coordinates(model_file)
+    columns = [j for j, label in enumerate(radians.labels) if label in rotational]
+    degrees = radians.data.copy()
+    degrees[:, columns] = np.rad2deg(degrees[:, columns])
+    ik_file = folder / "IKData" / "drive_kick1.sto"
+    write_storage(ik_file, attrs.evolve(radians, data=degrees))  # the header says inDegrees=no
+    expected = _between(f"{ik_file}: read with inDegrees=no, rotational column(s) ",
+                        " the numbers look like degrees: the header may be wrong (inDegrees=yes)")
+    with pytest.warns(UserWarning, match=expected):
+        assert nmsm_main(["surrogate", *common, "--data-dir", str(folder), "-o", str(tmp_path / "from_data.json")]) == 0
