@@ -2,7 +2,8 @@
 ``report``, ``export`` and ``plot`` (nmsm/io/output_file.py, docs/architecture.md "Output
 paths"): an input is never overwritten, every output is checked before anything is computed
 (a missing folder, a folder for a file, a file for a folder: one ``nmsm: error:`` line), a
-failure leaves no partial output, and single files are written atomically."""
+failure leaves no partial output, single files are written atomically, the several files of
+``muscle-analysis``, ``plot`` and ``surrogate --write-samples`` all or nothing."""
 
 from __future__ import annotations
 
@@ -28,7 +29,8 @@ KICK = Path("treatment") / "surrogate_kick_tutorial"
 @pytest.fixture(scope="module")
 def source(tmp_path_factory) -> Path:
     """A folder of small inputs: the built-in leg (model, motion, markers), activations, a
-    report tree, a personalized .osimx, a JMP results folder whose figures fail."""
+    report tree, a personalized .osimx, a JMP results folder whose figures fail, a treatment
+    results folder without figures (``treat``: two are drawn)."""
     folder = tmp_path_factory.mktemp("inputs")
     (folder / "leg.osim").write_bytes(leg_model_xml())
     model = load_model(folder / "leg.osim")
@@ -53,6 +55,10 @@ def source(tmp_path_factory) -> Path:
     (folder / "bad_jmp").mkdir()
     (folder / "bad_jmp" / "jmp_results.json").write_text("{}")  # detected as JMP results; its figures fail
     (folder / "empty").mkdir()
+    (folder / "treat" / "IKData").mkdir(parents=True)
+    t = np.linspace(0.0, 1.0, 5)
+    write_storage(folder / "treat" / "arm1_states.sto", table_from_columns(t, {"q": 0.1 * t, "q_u": 0.1 + 0 * t}))
+    write_storage(folder / "treat" / "arm1_torqueControls.sto", table_from_columns(t, {"q": np.sin(t)}))
     return folder
 
 
@@ -288,3 +294,141 @@ def test_a_failed_write_leaves_the_earlier_file(command: str, work: Path, capsys
     assert (work / output).read_text() == "earlier\n"
     assert [p.name for p in (work / "out").iterdir()] == [Path(output).name]  # no temporary file left
     assert main(argv) == 0 and (work / output).read_text() != "earlier\n"
+
+
+# ---- several files: all or nothing ----------------------------------------------------------
+def _second_call_fails(patch: pytest.MonkeyPatch, owner: object, name: str, error: str,
+                       path_argument: int = 0, call: int = 2) -> list[Path]:
+    """Make the second (``call``-th) call of ``owner.name`` raise: "disk", a full disk writing
+    the path it was given (its argument ``path_argument``); "stop", Ctrl-C. Returns the paths
+    given."""
+    real = getattr(owner, name)
+    paths: list[Path] = []
+
+    def failing(*args, **kwargs):
+        path = Path(args[path_argument])
+        paths.append(path)
+        if len(paths) == call:
+            raise KeyboardInterrupt if error == "stop" else OSError(28, "No space left on device", str(path))
+        return real(*args, **kwargs)
+
+    patch.setattr(owner, name, failing)
+    return paths
+
+
+def _listing(folder: Path, *, folder_times: bool = False) -> dict[str, tuple[bool, int, bytes]]:
+    """Every path below ``folder`` (hidden ones too): (is a folder, mtime in ns, bytes). A
+    folder's mtime (changed by any file created and removed in it, e.g. a staging folder)
+    only with ``folder_times``."""
+    return {str(p.relative_to(folder)): (p.is_dir(), p.stat().st_mtime_ns if folder_times or not p.is_dir() else 0,
+                                         b"" if p.is_dir() else p.read_bytes())
+            for p in sorted(folder.rglob("*"))}
+
+
+def _ends(argv: list[str], error: str, capsys: pytest.CaptureFixture[str]) -> str:
+    """Run ``nmsm argv``, which fails on a full disk (exit status 1) or is stopped (130);
+    returns what it printed (stdout and stderr)."""
+    capsys.readouterr()
+    assert main(argv) == (130 if error == "stop" else 1)
+    captured = capsys.readouterr()
+    return captured.out + captured.err
+
+
+@pytest.mark.parametrize("error", ["disk", "stop"])
+@pytest.mark.parametrize("earlier", [False, True])
+def test_muscle_analysis_writes_all_its_files_or_none(error: str, earlier: bool, work: Path, capsys,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """The second of the 13 files fails: no file of the run is left (not the first, not a
+    staged one), an earlier run's file is unchanged, the folders the run created are removed."""
+    import nmsm.model.muscle_analysis as muscle_analysis
+
+    if earlier:
+        (work / "out" / "MA" / "leg").mkdir(parents=True)
+        (work / "out" / "MA" / "leg" / "leg_Length.sto").write_text("earlier\n")
+    before = _listing(work / "out")
+    argv = ["muscle-analysis", "leg.osim", "leg.sto", "-o", "out/MA"]
+    with monkeypatch.context() as patch:
+        paths = _second_call_fails(patch, muscle_analysis, "write_storage", error)
+        printed = _ends(argv, error, capsys)
+    assert [p.name for p in paths] == ["leg_Length.sto", "leg_Velocity.sto"]
+    if error == "disk":
+        assert "nmsm: error: out/MA/leg/leg_Velocity.sto: cannot write the output file: No space left on device" \
+               in printed, printed
+    assert _listing(work / "out") == before
+    assert main(["muscle-analysis", "leg.osim", "leg.sto", "-o", "out/MA"]) == 0
+    written = sorted(p.name for p in (work / "out" / "MA" / "leg").iterdir())
+    assert len(written) == 13 and all(name.startswith("leg_") for name in written), written
+    assert (work / "out" / "MA" / "leg" / "leg_Length.sto").read_text() != "earlier\n"
+
+
+@pytest.mark.parametrize("error", ["disk", "stop"])
+@pytest.mark.parametrize("earlier", [False, True])
+@pytest.mark.parametrize("output", [None, "out/figures"])
+def test_plot_draws_a_folder_s_figures_all_or_none(error: str, earlier: bool, output: str | None, work: Path,
+                                                   capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The second of the treatment folder's two figures fails: neither is left, an earlier
+    figure is unchanged, the figure folder the run created is removed."""
+    import matplotlib.figure
+
+    plots = work / "treat" / "plots" if output is None else work / output
+    if earlier:
+        plots.mkdir()
+        (plots / "arm1_kinematics.png").write_bytes(b"earlier")
+    before = _listing(work)
+    argv = ["plot", "treat"] + ([] if output is None else ["-o", output])
+    with monkeypatch.context() as patch:
+        paths = _second_call_fails(patch, matplotlib.figure.Figure, "savefig", error, path_argument=1)
+        printed = _ends(argv, error, capsys)
+    assert [p.name for p in paths] == ["arm1_kinematics.png", "arm1_controls.png"]
+    if error == "disk":
+        where = Path(output) if output else Path("treat") / "plots"
+        assert f"no figures (InputError: {where / 'arm1_controls.png'}: cannot write the output file: No space " \
+               "left on device" in printed, printed
+    assert _listing(work) == before
+    assert main(argv) == 0
+    assert sorted(p.name for p in plots.iterdir()) == ["arm1_controls.png", "arm1_kinematics.png"]
+    assert (plots / "arm1_kinematics.png").read_bytes() != b"earlier"
+
+
+@pytest.mark.parametrize("error", ["disk", "stop"])
+@pytest.mark.parametrize("failing", ["samples", "surrogate"])
+def test_surrogate_writes_its_file_and_the_samples_all_or_none(error: str, failing: str, work: Path, capsys,
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--write-samples`` fails at its third file (MAData's velocities, after IKData and the
+    lengths), or the surrogate file fails after every sample is written: no sample file is
+    left, the earlier surrogate file is unchanged, the samples folder the run created is
+    removed. (OpenSim's sampling is replaced by a knee muscle whose length is linear.)"""
+    import nmsm.model.muscle_analysis as muscle_analysis
+    import nmsm.tools.surrogate.sampling as sampling
+    from nmsm.model.surrogate import GeometrySamples, SurrogateModel
+
+    def poses(model_file, motion, **options):
+        return ("knee_angle",), np.random.default_rng(0).uniform(-1.0, 0.0, (60, 1))
+
+    def samples(model_file, coordinates, q, surrogate_coordinates, **options):
+        return GeometrySamples(surrogate_coordinates, ("knee_muscle",), q, 0.3 - 0.04 * q, np.full((len(q), 1, 1), 0.04))
+
+    monkeypatch.setattr(sampling, "poses_around_motion", poses)
+    monkeypatch.setattr(sampling, "opensim_samples", samples)
+    (work / "out" / "s.json").write_text("earlier\n")
+    before = _listing(work / "out")
+    argv = ["surrogate", "--model", "leg.osim", "--motion", "leg.sto", "--coordinates", "knee_angle",
+            "-o", "out/s.json", "--write-samples", "out/samples"]
+    with monkeypatch.context() as patch:
+        if failing == "samples":
+            paths = _second_call_fails(patch, muscle_analysis, "write_storage", error)
+            target = "out/samples/MAData/leg/leg_Velocity.sto"
+        else:
+            paths = _second_call_fails(patch, SurrogateModel, "save", error, path_argument=1, call=1)
+            target = "out/s.json"
+        printed = _ends(argv, error, capsys)
+    assert paths and paths[-1].name == Path(target).name
+    if error == "disk":
+        assert f"nmsm: error: {target}: cannot write the output file: No space left on device" in printed, printed
+    assert _listing(work / "out") == before
+    assert main(argv) == 0
+    written = sorted(str(p.relative_to(work / "out")) for p in (work / "out").rglob("*") if p.is_file())
+    assert written == ["s.json", "samples/IKData/leg.sto", "samples/MAData/leg/leg_Length.sto",
+                       "samples/MAData/leg/leg_MomentArm_knee_angle.sto"], written
+    assert SurrogateModel.load(work / "out" / "s.json").muscle_names == ("knee_muscle",)
+

@@ -16,14 +16,24 @@ Before anything is written (:func:`check_output`, :func:`check_output_folder`):
 :func:`write_output` (text) and :func:`write_atomically` (any writer) write into a temporary
 file in the output's folder and move it into place with :func:`os.replace`, so a failure
 leaves the earlier file (or none), never a half-written one.
+
+:func:`staged_outputs` does the same for the several files of one command (``muscle-analysis``,
+``plot``, ``surrogate --write-samples``, ``export --loads``): they are written into hidden
+staging folders inside the folders they go to (the same filesystem) and moved into place only
+when every one is complete. A failure or a stop (``KeyboardInterrupt``) before that, or while
+moving, leaves the earlier files as they were and removes the staged files and the folders the
+command created.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import secrets
+import shutil
 import stat
 import tempfile
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import TypeVar
 
@@ -240,3 +250,169 @@ def remove_new_folders(root: Path, existing: Iterable[Path]) -> None:
 def folders_below(root: Path) -> list[Path]:
     """``root`` (when it exists) and every folder below it."""
     return [Path(folder) for folder, _, _ in os.walk(root)] if root.is_dir() else []
+
+
+#: prefix of the staging folders of :func:`staged_outputs` (hidden: ``nmsm plot`` and the
+#: results-folder searches skip them)
+STAGING_PREFIX = ".nmsm-staging-"
+
+
+class StagedOutputs:
+    """The output files of one command, staged next to where they go (:func:`staged_outputs`).
+
+    :meth:`folder` gives a staging folder whose files (and sub-folders) go into a destination
+    folder, :meth:`file` where to write one destination file; :meth:`destination` maps a
+    staged path back to where it goes.
+    """
+
+    def __init__(self) -> None:
+        self._stages: dict[Path, Path] = {}  # destination folder -> its staging folder
+        self._created: list[Path] = []  # folders this command created, in creation order
+
+    def folder(self, destination: str | os.PathLike[str]) -> Path:
+        """The staging folder of ``destination`` (created with ``destination`` when missing)."""
+        destination = Path(destination)
+        for known, stage in self._stages.items():
+            if os.path.abspath(known) == os.path.abspath(destination):
+                return stage
+        self._make_folder(destination)
+        try:
+            stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=destination))
+        except OSError as exc:
+            raise InputError(f"cannot write the output folder: {exc.strerror or exc}", file=destination,
+                             expected="a writable folder") from None
+        self._stages[destination] = stage
+        return stage
+
+    def file(self, path: str | os.PathLike[str]) -> Path:
+        """Where to write the output file ``path``: in the staging folder of its folder."""
+        path = Path(path)
+        return self.folder(path.parent) / path.name
+
+    def destination(self, staged: str | os.PathLike[str]) -> Path:
+        """Where the staged file ``staged`` goes (``staged`` itself when it is not staged)."""
+        staged = Path(staged)
+        absolute = Path(os.path.abspath(staged))
+        for destination, stage in self._stages.items():
+            if absolute.is_relative_to(os.path.abspath(stage)):
+                return destination / absolute.relative_to(os.path.abspath(stage))
+        return staged
+
+    def _make_folder(self, folder: Path) -> None:
+        """Create ``folder`` and its missing parents, remembering them for :meth:`_discard`."""
+        missing = []
+        probe = folder
+        while not probe.exists() and not probe.is_symlink() and probe != probe.parent:
+            missing.append(probe)
+            probe = probe.parent
+        for path in reversed(missing):
+            try:
+                path.mkdir()
+            except FileExistsError:
+                continue
+            except OSError as exc:
+                raise InputError(f"cannot create the output folder: {exc.strerror or exc}", file=path,
+                                 expected="a writable folder") from None
+            self._created.append(path)
+
+    def _staged_files(self) -> list[tuple[Path, Path]]:
+        """``(staged file, destination)`` of every staged file."""
+        return [(src, destination / src.relative_to(stage)) for destination, stage in self._stages.items()
+                for src in sorted(stage.rglob("*")) if src.is_file()]
+
+    def _commit(self) -> None:
+        """Make every staged file durable, then move them all into place; a failure while
+        moving puts the files moved so far back (the earlier files restored)."""
+        moves = self._staged_files()
+        for src, dest in moves:
+            if dest.is_dir() and not dest.is_symlink():
+                raise InputError("cannot write the output file: a folder of that name exists", file=dest,
+                                 expected="a file name that is not a folder")
+            try:
+                _flush_to_disk(src)
+                os.chmod(src, _mode_for(dest))
+            except OSError as exc:
+                raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=dest,
+                                 expected="a writable folder") from None
+        done: list[tuple[Path, Path, Path | None]] = []
+        try:
+            for src, dest in moves:
+                self._make_folder(dest.parent)
+                earlier = dest.exists() or dest.is_symlink()
+                backup = dest.with_name(f".{dest.name}.nmsm-replaced-{secrets.token_hex(4)}") if earlier else None
+                done.append((src, dest, backup))
+                if backup is not None:
+                    os.replace(dest, backup)
+                os.replace(src, dest)
+        except BaseException as exc:
+            _put_back(done)
+            if isinstance(exc, OSError):
+                where = done[-1][1] if done else Path(exc.filename or "")
+                raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=where,
+                                 expected="a writable folder") from None
+            raise
+        for _, _, backup in done:
+            if backup is not None:
+                with contextlib.suppress(OSError):
+                    backup.unlink()
+
+    def _remove_stages(self) -> None:
+        for stage in self._stages.values():
+            shutil.rmtree(stage, ignore_errors=True)
+
+    def _discard(self) -> None:
+        """Remove the staged files and the folders this command created (when left empty)."""
+        self._remove_stages()
+        for folder in reversed(self._created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        self._created = []
+
+    def _named(self, exc: OSError) -> OSError | InputError:
+        """An :class:`InputError` naming the destination of a staged file that could not be
+        written; other errors as they are."""
+        if not isinstance(exc.filename, (str, bytes, os.PathLike)):
+            return exc
+        staged = Path(os.fsdecode(exc.filename))
+        where = self.destination(staged)
+        if where is staged:
+            return exc
+        return InputError(f"cannot write the output file: {exc.strerror or exc}", file=where,
+                          expected="a writable folder")
+
+
+def _put_back(done: list[tuple[Path, Path, Path | None]]) -> None:
+    """Undo the moves of :meth:`StagedOutputs._commit`, last first: each earlier file back
+    in place, each new file removed."""
+    for src, dest, backup in reversed(done):
+        with contextlib.suppress(OSError):
+            if backup is not None and backup.exists():
+                os.replace(backup, dest)
+            elif not (src.exists() or src.is_symlink()):
+                dest.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def staged_outputs() -> Iterator[StagedOutputs]:
+    """Write several output files all or nothing (module docstring)::
+
+        with staged_outputs() as staged:
+            result.write(staged.folder(output_folder), trial)   # files under output_folder
+            model.save(staged.file(json_path))                  # one file
+        # every file in place now; on any exception none of them is, earlier files unchanged
+
+    An :class:`OSError` writing a staged file becomes an :class:`InputError` naming its
+    destination.
+    """
+    staged = StagedOutputs()
+    try:
+        yield staged
+        staged._commit()
+    except BaseException as exc:
+        staged._discard()
+        if isinstance(exc, OSError):
+            named = staged._named(exc)
+            if named is not exc:
+                raise named from None
+        raise
+    staged._remove_stages()

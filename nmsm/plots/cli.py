@@ -4,8 +4,11 @@ The folder itself and every folder below it (``plots`` and hidden folders skippe
 tested against each tool's results layout; each match is drawn by the tool's plot module
 (:mod:`nmsm.plots.jmp`, ``mtp``, ``ncp``, ``gcp``, ``treatment``) into ``<folder>/plots``, or
 into ``--output/<folder relative to RESULTS_DIR>``. A pipeline results tree (``nmsm
-pipeline``) gets every stage's figures this way. A folder whose figures fail is reported
-and the others are still drawn (exit code 1).
+pipeline``) gets every stage's figures this way. Each folder's figures are drawn into a
+hidden staging folder and moved into place together when all are drawn
+(:func:`nmsm.io.output_file.staged_outputs`): a folder whose figures fail gets none of them
+(its earlier figures stay, folders created for it are removed), is reported, and the others
+are still drawn (exit code 1); Ctrl-C keeps the folders finished before it.
 """
 
 from __future__ import annotations
@@ -76,17 +79,21 @@ def results_folders(root: str | os.PathLike[str]) -> list[tuple[str, Path]]:
 
 def plot_tree(root: str | os.PathLike[str], output: str | os.PathLike[str] | None = None,
               log: Callable[[str], None] = print) -> tuple[dict[Path, list[Path]], dict[Path, str]]:
-    """Draw every results folder below ``root``; returns (figures per folder, errors per folder)."""
+    """Draw every results folder below ``root``, each folder's figures all or nothing (module
+    docstring); returns (figures per folder, errors per folder)."""
     from nmsm.errors import NmsmError
+    from nmsm.io.output_file import staged_outputs
 
     root = Path(root)
     figures: dict[Path, list[Path]] = {}
     errors: dict[Path, str] = {}
     by_tool = {p.tool: p for p in PLOTTERS}
     for tool, folder in results_folders(root):
-        target = None if output is None else Path(output) / folder.relative_to(root)
+        target = folder / "plots" if output is None else Path(output) / folder.relative_to(root)
         try:
-            figures[folder] = by_tool[tool].draw(folder, target)
+            with staged_outputs() as staged:
+                drawn = by_tool[tool].draw(folder, staged.folder(target))
+            figures[folder] = [staged.destination(p) for p in drawn]
             log(f"{tool:<10s} {folder}: {len(figures[folder])} figure(s)")
         except (NmsmError, OSError, ValueError, KeyError) as exc:
             errors[folder] = f"{type(exc).__name__}: {exc}"
@@ -96,9 +103,9 @@ def plot_tree(root: str | os.PathLike[str], output: str | os.PathLike[str] | Non
 
 def _plot(args: argparse.Namespace) -> int:
     """``nmsm plot``: ``-o`` checked first (a folder, or a new one in an existing folder); the
-    folders it created and left empty (a results folder that failed) are removed again."""
+    folders it created for a results folder that failed are removed again (:func:`plot_tree`)."""
     from nmsm.errors import InputError
-    from nmsm.io.output_file import check_output_folder, folders_below, remove_new_folders
+    from nmsm.io.output_file import check_output_folder
 
     root = Path(args.results)
     if not root.is_dir():
@@ -106,12 +113,7 @@ def _plot(args: argparse.Namespace) -> int:
     output = None
     if args.output:
         output = check_output_folder(args.output, what="a folder for the figures (default: <each folder>/plots)")
-    before = folders_below(output) if output is not None else []
-    try:
-        figures, errors = plot_tree(root, output)
-    finally:
-        if output is not None:  # a folder drawn into is kept; one left empty by a failure is not
-            remove_new_folders(output, before)
+    figures, errors = plot_tree(root, output)
     if not figures and not errors:
         print(f"nmsm: no results folder of JMP, MTP, NCP, GCP or treatment optimization in {root}", file=sys.stderr)
         return 1

@@ -105,21 +105,23 @@ def _check_export(args: argparse.Namespace) -> tuple[Path | None, Path | None, A
 
 
 def _export(args: argparse.Namespace) -> int:
-    """``nmsm export``: everything checked first; the .osim written atomically, then the loads."""
+    """``nmsm export``: everything checked first; the .osim, the ExternalLoads XML and its
+    .mot staged and moved into place together (all or nothing)."""
     import attrs
 
     from nmsm.interop.external_loads import write_external_loads
     from nmsm.interop.osim_export import export_osimx
-    from nmsm.io.output_file import write_atomically
+    from nmsm.io.output_file import staged_outputs
 
     osim, xml, reactions = _check_export(args)
-    if osim is not None:
-        report = write_atomically(osim, lambda temporary: export_osimx(
-            args.osimx, temporary, model_path=args.model, include_contact=not args.no_contact))
+    with staged_outputs() as staged:
+        report = None if osim is None else export_osimx(args.osimx, staged.file(osim), model_path=args.model,
+                                                        include_contact=not args.no_contact)
+        loads = None if xml is None else write_external_loads(staged.file(xml), reactions)
+    if report is not None:
         print(attrs.evolve(report, model=osim).text())
-    if xml is not None:
-        xml, data = write_external_loads(xml, reactions)
-        print(f"wrote {xml} and {data}")
+    if loads is not None:
+        print(f"wrote {staged.destination(loads[0])} and {staged.destination(loads[1])}")
     return 0
 
 

@@ -14,6 +14,10 @@ Surrogate, three ways to give the samples:
 
 Muscle analysis: ``nmsm muscle-analysis MODEL MOTION --output MAData`` writes
 ``MAData/<trial>/<trial>_Length.sto``, ``_Velocity.sto`` and ``_MomentArm_<coord>.sto``.
+
+Both write their files all or nothing (:func:`nmsm.io.output_file.staged_outputs`): the
+surrogate file and the ``--write-samples`` folder together, the muscle analysis's files
+together; a failure or Ctrl-C leaves the earlier files and no new ones.
 """
 
 from __future__ import annotations
@@ -21,10 +25,13 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from nmsm.cli_types import fraction, non_negative_float, number, positive_float, positive_int
 from nmsm.errors import InputError
+
+if TYPE_CHECKING:
+    from nmsm.io.output_file import StagedOutputs
 
 
 def _check_arguments(args: argparse.Namespace) -> None:
@@ -79,9 +86,10 @@ def _check_outputs(args: argparse.Namespace, settings: Any) -> None:
     check_outputs({option: output}, inputs, protected_folders=folders, example_names={option: "surrogateMuscles.json"})
 
 
-def _fit(args: argparse.Namespace) -> tuple[Any, Path, bool]:
+def _fit(args: argparse.Namespace, staged: StagedOutputs) -> tuple[Any, Path, bool]:
     """The surrogate the arguments ask for, where it goes, and whether it is written already
-    (a settings file that loads an existing surrogate). Every output is checked first."""
+    (a settings file that loads an existing surrogate). Every output is checked first;
+    ``--write-samples`` is written into ``staged``."""
     import attrs
 
     from nmsm.io.storage import read_storage
@@ -111,7 +119,7 @@ def _fit(args: argparse.Namespace) -> tuple[Any, Path, bool]:
     samples = opensim_samples(args.model, coords, poses, args.coordinates, muscles=args.muscles,
                               moment_arms=args.moment_arms)
     if args.write_samples:
-        _write_samples(Path(args.write_samples), Path(args.motion).stem, coords, poses, samples)
+        _write_samples(staged.folder(args.write_samples), Path(args.motion).stem, coords, poses, samples)
     meta = {"model_file": str(Path(args.model).resolve()), "motion": str(Path(args.motion).resolve()),
             "samples_per_frame": args.samples_per_frame, "angular_padding_deg": args.angular_padding,
             "linear_padding_m": args.linear_padding, "moment_arms": args.moment_arms, "seed": args.seed,
@@ -138,13 +146,15 @@ def _write_samples(folder: Path, trial: str, coords: tuple[str, ...], poses: Any
 
 
 def _surrogate(args: argparse.Namespace) -> int:
-    """``nmsm surrogate``: outputs checked, the surrogate fitted, its file written atomically."""
-    from nmsm.io.output_file import write_atomically
+    """``nmsm surrogate``: outputs checked, the surrogate fitted; its file and the samples
+    (``--write-samples``) moved into place together."""
+    from nmsm.io.output_file import staged_outputs
     from nmsm.tools.surrogate.tool import accuracy_report
 
-    model, path, saved = _fit(args)
-    if not saved:
-        write_atomically(path, model.save)
+    with staged_outputs() as staged:
+        model, path, saved = _fit(args, staged)
+        if not saved:
+            model.save(staged.file(path))
     print(accuracy_report(model))
     print(f"surrogate of {len(model.muscles)} muscles, degree {model.degree}, written to {path}")
     return 0
@@ -172,7 +182,9 @@ def _check_analysis_folder(args: argparse.Namespace, trial: str) -> Path:
 
 
 def _muscle_analysis(args: argparse.Namespace) -> int:
-    """``nmsm muscle-analysis``: the output folder checked, the geometry computed, the files written."""
+    """``nmsm muscle-analysis``: the output folder checked, the geometry computed, the files
+    moved into place together."""
+    from nmsm.io.output_file import staged_outputs
     from nmsm.model.muscle_analysis import analyze_motion, check_trial_name
     from nmsm.model.surrogate import SurrogateModel
 
@@ -181,7 +193,8 @@ def _muscle_analysis(args: argparse.Namespace) -> int:
     surrogate = SurrogateModel.load(args.surrogate) if args.surrogate else None
     result = analyze_motion(args.model, args.motion, muscles=args.muscles, coordinates=args.coordinates,
                             engine=args.engine, surrogate=surrogate, lowpass_hz=args.lowpass)
-    paths = result.write(folder, trial)
+    with staged_outputs() as staged:
+        paths = [staged.destination(p) for p in result.write(staged.folder(folder), trial)]
     counts: dict[str, int] = {}
     for source in result.sources.values():
         counts[source] = counts.get(source, 0) + 1

@@ -173,3 +173,43 @@ def test_reaction_from_resultant_round_trip(tmp_path: Path) -> None:
     loads = read_external_loads(xml)
     assert loads.data_file == data.resolve() or loads.data_file.resolve() == data.resolve()
     assert loads.forces[0].body == "calcn_r" and loads.forces[0].point_identifier == "g_force_p"
+
+
+@pytest.mark.parametrize("error", ["disk", "stop"])
+def test_export_writes_the_model_and_the_loads_all_or_none(error: str, subject, tmp_path: Path, capsys,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    """``nmsm export -o MODEL --treatment DIR --loads LOADS.xml`` fails writing the XML, after
+    the .osim and the .mot: none of the three is left, the earlier .mot is unchanged; then the
+    three are written together."""
+    from nmsm.cli import main
+
+    osimx = _personalized_osimx(subject, tmp_path)
+    solution, _, _ = _solution_folder(subject, tmp_path / "solution")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "loads.mot").write_text("earlier\n")
+    argv = ["export", str(osimx), "-o", str(out / "model.osim"), "--no-contact", "--treatment", str(solution),
+            "--loads", str(out / "loads.xml")]
+    real = Path.write_bytes
+    calls: list[Path] = []
+
+    def failing(self: Path, data: bytes) -> int:
+        calls.append(self)
+        if self.suffix == ".xml":
+            raise KeyboardInterrupt if error == "stop" else OSError(28, "No space left on device", str(self))
+        return real(self, data)
+
+    capsys.readouterr()
+    with monkeypatch.context() as patch:
+        patch.setattr(Path, "write_bytes", failing)
+        assert main(argv) == (130 if error == "stop" else 1)
+    assert [p.name for p in calls] == ["loads.xml"]
+    if error == "disk":
+        assert f"nmsm: error: {out / 'loads.xml'}: cannot write the output file: No space left on device" \
+               in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["loads.mot"]  # no .osim, no staging folder
+    assert (out / "loads.mot").read_text() == "earlier\n"
+    assert main(argv) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["loads.mot", "loads.xml", "model.osim"]
+    assert "<datafile>loads.mot</datafile>" in (out / "loads.xml").read_text()
+    assert read_storage(out / "loads.mot").n_rows > 100
