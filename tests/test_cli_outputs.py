@@ -3,7 +3,8 @@
 paths"): an input is never overwritten, every output is checked before anything is computed
 (a missing folder, a folder for a file, a file for a folder: one ``nmsm: error:`` line), a
 failure leaves no partial output, single files are written atomically, the several files of
-``muscle-analysis``, ``plot`` and ``surrogate --write-samples`` all or nothing."""
+``muscle-analysis``, ``plot`` and ``surrogate --write-samples`` all or nothing, and
+``report`` leaves the tree it reports on untouched."""
 
 from __future__ import annotations
 
@@ -432,3 +433,20 @@ def test_surrogate_writes_its_file_and_the_samples_all_or_none(error: str, faili
                        "samples/MAData/leg/leg_MomentArm_knee_angle.sto"], written
     assert SurrogateModel.load(work / "out" / "s.json").muscle_names == ("knee_muscle",)
 
+
+# ---- report: the tree it reads is left as it was ---------------------------------------------
+@pytest.mark.parametrize("output", ["out/r.html", None])
+def test_report_leaves_the_results_tree_untouched(output: str | None, work: Path, capsys) -> None:
+    """The treatment folder has no figures: the report draws them outside the tree and embeds
+    them; no path, byte or time of the tree changes (but for the report itself when it goes
+    into the tree, the default)."""
+    before = _listing(work / "treat", folder_times=output is not None)
+    capsys.readouterr()
+    assert main(["report", "treat"] + (["-o", output] if output else [])) == 0
+    page = work / (output or "treat/report.html")
+    assert capsys.readouterr().out == f"wrote {Path(output or 'treat/report.html')}\n"
+    after = _listing(work / "treat", folder_times=output is not None)
+    if output is None:
+        assert after.pop("report.html")[2] == page.read_bytes()
+    assert after == before
+    assert page.read_text().count("data:image/png;base64,") == 2  # the two figures, embedded

@@ -3,9 +3,12 @@
 The stages of a pipeline results tree come from its ``pipeline_state.json`` (in pipeline
 order, with each stage's kind and time); any other folder is searched for tool results
 folders (:func:`nmsm.plots.cli.results_folders`). For each stage: its tables
-(:mod:`nmsm.report.tables`) and its figures, drawn by the tool's plot module into
-``<stage>/plots`` when that folder has none yet, embedded as base64 PNG so the page is one
-file that can be mailed. The example adds its known-answer comparison on top.
+(:mod:`nmsm.report.tables`) and its figures, embedded as base64 PNG so the page is one file
+that can be mailed: the PNGs of ``<stage>/plots`` when there are any (``nmsm plot``),
+otherwise drawn by the tool's plot module into a temporary folder that is removed once the
+page is built. The report reads the results tree and never writes into it (the page itself
+goes where it is told, by default ``<results>/report.html``). The example adds its
+known-answer comparison on top.
 """
 
 from __future__ import annotations
@@ -15,10 +18,12 @@ import datetime
 import html
 import json
 import os
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from nmsm.errors import InputError
+from nmsm.io.output_file import write_output
 from nmsm.report.tables import BUILDERS, ReportTable, checks_table
 
 REPORT_FILE = "report.html"
@@ -66,7 +71,9 @@ def _table_html(table: ReportTable) -> str:
     return f"<h3>{html.escape(table.title)}</h3><table><tr>{head}</tr>{''.join(body)}</table>{note}"
 
 
-def _figures(section: str, folder: Path, log: Callable[[str], None] | None) -> list[Path]:
+def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], None] | None) -> list[Path]:
+    """The PNGs of ``folder/plots``, or (none there) those the tool's plot module draws into
+    ``scratch`` (a new folder outside the results tree)."""
     from nmsm.plots.cli import PLOTTERS
 
     plots = folder / "plots"
@@ -78,7 +85,7 @@ def _figures(section: str, folder: Path, log: Callable[[str], None] | None) -> l
     if plotter is None or not plotter.matches(folder):
         return []
     try:
-        return sorted(p for p in plotter.draw(folder, None) if Path(p).suffix == ".png")
+        return sorted(p for p in plotter.draw(folder, scratch) if Path(p).suffix == ".png")
     except Exception as exc:  # a figure that cannot be drawn must not lose the rest of the report
         if log:
             log(f"report: no figures for {folder} ({type(exc).__name__}: {exc})")
@@ -90,10 +97,28 @@ def _image(path: Path) -> str:
     return f"<div><img alt=\"{html.escape(Path(path).name)}\" src=\"data:image/png;base64,{data}\"></div>"
 
 
+def _section(name: str, section: str, folder: Path, description: str, scratch: Path,
+             log: Callable[[str], None] | None) -> list[str]:
+    """The HTML parts of one stage: heading, tables, figures (drawn into ``scratch`` if need be)."""
+    parts = [f"<h2>{html.escape(name)}</h2><p class=\"note\">{html.escape(description)}: "
+             f"{html.escape(str(folder))}</p>"]
+    builder = BUILDERS.get(section)
+    if builder is not None:
+        try:
+            tables = builder(folder)
+        except (OSError, ValueError, KeyError, StopIteration, InputError) as exc:
+            tables = [ReportTable("tables unavailable", ("reason",), ((f"{type(exc).__name__}: {exc}",),))]
+        parts.extend(_table_html(t) for t in tables)
+    parts.extend(_image(p) for p in _figures(section, folder, scratch, log))
+    return parts
+
+
 def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str] | None = None, *,
                  checks: Sequence | None = None, title: str | None = None,
                  log: Callable[[str], None] | None = print) -> Path:
-    """Write the report of ``results`` (a pipeline tree or a results folder); returns its path."""
+    """Write the report of ``results`` (a pipeline tree or a results folder) to ``output``
+    (default ``<results>/report.html``) atomically; returns its path. Nothing else is written
+    (module docstring)."""
     root = Path(results)
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
@@ -106,19 +131,11 @@ def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str]
              f"{datetime.datetime.now().isoformat(timespec='seconds')}</p>"]
     if checks:
         parts.append("<h2>Known-answer comparison</h2>" + _table_html(checks_table(checks)))
-    for name, section, folder, description in stages:
-        parts.append(f"<h2>{html.escape(name)}</h2><p class=\"note\">{html.escape(description)}: "
-                     f"{html.escape(str(folder))}</p>")
-        builder = BUILDERS.get(section)
-        if builder is not None:
-            try:
-                tables = builder(folder)
-            except (OSError, ValueError, KeyError, StopIteration, InputError) as exc:
-                tables = [ReportTable("tables unavailable", ("reason",), ((f"{type(exc).__name__}: {exc}",),))]
-            parts.extend(_table_html(t) for t in tables)
-        parts.extend(_image(p) for p in _figures(section, folder, log))
+    with tempfile.TemporaryDirectory(prefix="nmsm-report-") as drawn:
+        for k, (name, section, folder, description) in enumerate(stages):
+            parts.extend(_section(name, section, folder, description, Path(drawn) / str(k), log))
     page = (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(title or 'nmsm report')}</title>"
             f"<style>{_STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
     target = Path(output) if output is not None else root / REPORT_FILE
-    target.write_text(page, encoding="utf-8")
+    write_output(target, page)
     return target

@@ -51,12 +51,12 @@ def _report_target(args: argparse.Namespace) -> tuple[Path, Path]:
 
 
 def _report(args: argparse.Namespace) -> int:
-    """``nmsm report``: the output checked, the page built and written atomically."""
-    from nmsm.io.output_file import write_atomically
+    """``nmsm report``: the output checked, the page built and written atomically; the
+    results tree is only read (figures it lacks are drawn outside it)."""
     from nmsm.report.html import write_report
 
     root, target = _report_target(args)
-    write_atomically(target, lambda temporary: write_report(root, temporary))
+    write_report(root, target)
     print(f"wrote {target}")
     return 0
 

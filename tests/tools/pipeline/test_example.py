@@ -103,6 +103,29 @@ def test_report_and_plots_of_the_tree(early, tmp_path: Path) -> None:
     assert page.count("data:image/png;base64,") >= 1
 
 
+def test_report_leaves_the_results_tree_untouched(early, tmp_path: Path, capsys) -> None:
+    """``nmsm report`` on a copy of the example's tree without figures: every stage's figures
+    are drawn outside the tree and embedded; no path, byte or modification time of the tree
+    changes. The example's own report (written by run_example) drew none into the tree either."""
+    import shutil
+
+    assert not list(early.results.rglob("plots"))
+    tree = tmp_path / "results"
+    shutil.copytree(early.results, tree, symlinks=True)
+
+    def listing() -> dict[str, tuple[bool, int, bytes]]:
+        return {str(p.relative_to(tree)): (p.is_dir(), p.stat().st_mtime_ns, b"" if p.is_dir() else p.read_bytes())
+                for p in sorted(tree.rglob("*"))}
+
+    before = listing()
+    root_time = tree.stat().st_mtime_ns
+    capsys.readouterr()
+    assert main(["report", str(tree), "-o", str(tmp_path / "r.html")]) == 0
+    assert listing() == before and tree.stat().st_mtime_ns == root_time
+    page = (tmp_path / "r.html").read_text()
+    assert page.count("data:image/png;base64,") >= 2 and "jmp_summary.png" in page
+
+
 def test_commands(early, capsys) -> None:
     assert main(["pipeline", str(early.folder / "pipeline.xml"), "--check"]) == 0
     out = capsys.readouterr().out
