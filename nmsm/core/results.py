@@ -21,6 +21,10 @@ wrote there move into ``superseded/``, and any other file a result replaces (a u
 earlier tool's or program's result of the same name) is moved there too, with a warning, so
 a rerun never mixes with an earlier run's files and never deletes a file it did not write.
 
+A task's files are moved in all or none (:func:`nmsm.io.output_file.move_into_place`): a
+failure or a stop while moving puts back the files moved so far and the earlier files they
+replaced.
+
 The folder is created when the first task starts, and removed again if that task fails and
 leaves it empty, so a run refused for bad input leaves no empty results folder behind.
 Results folders equal to or inside an input folder (``input_folders``) are refused at
@@ -38,6 +42,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
 from nmsm.errors import InputError
+from nmsm.io.output_file import move_into_place
 
 #: folder (inside the results folder) that retired files of an earlier run are moved into
 SUPERSEDED = "superseded"
@@ -188,10 +193,8 @@ class ResultsDirectory:
         if self._record is not None:
             self._begin_run()
             self._set_aside([src.relative_to(stage) for src in files])
-        for src in files:
-            dest = self.path / src.relative_to(stage)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(src, dest)
+        move_into_place([(src, self.path / src.relative_to(stage)) for src in files],
+                        lambda folder: folder.mkdir(parents=True, exist_ok=True))
         return [src.relative_to(stage) for src in files]
 
     def _begin_run(self) -> None:

@@ -232,26 +232,6 @@ def write_output(path: Path, text: str) -> None:
     write_atomically(path, lambda temporary: temporary.write_text(text, encoding="utf-8"))
 
 
-def remove_new_folders(root: Path, existing: Iterable[Path]) -> None:
-    """Remove the empty folders at and below ``root`` that are not in ``existing`` (folders
-    a failed command created and left empty); folders holding files are kept."""
-    before = {Path(p).resolve() for p in existing}
-    if not root.is_dir():
-        return
-    for folder, _, _ in sorted(os.walk(root), key=lambda entry: -len(Path(entry[0]).parts)):
-        path = Path(folder)
-        if path.resolve() not in before and not any(path.iterdir()):
-            try:
-                path.rmdir()
-            except OSError:
-                pass
-
-
-def folders_below(root: Path) -> list[Path]:
-    """``root`` (when it exists) and every folder below it."""
-    return [Path(folder) for folder, _, _ in os.walk(root)] if root.is_dir() else []
-
-
 #: prefix of the staging folders of :func:`staged_outputs` (hidden: ``nmsm plot`` and the
 #: results-folder searches skip them)
 STAGING_PREFIX = ".nmsm-staging-"
@@ -334,27 +314,7 @@ class StagedOutputs:
             except OSError as exc:
                 raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=dest,
                                  expected="a writable folder") from None
-        done: list[tuple[Path, Path, Path | None]] = []
-        try:
-            for src, dest in moves:
-                self._make_folder(dest.parent)
-                earlier = dest.exists() or dest.is_symlink()
-                backup = dest.with_name(f".{dest.name}.nmsm-replaced-{secrets.token_hex(4)}") if earlier else None
-                done.append((src, dest, backup))
-                if backup is not None:
-                    os.replace(dest, backup)
-                os.replace(src, dest)
-        except BaseException as exc:
-            _put_back(done)
-            if isinstance(exc, OSError):
-                where = done[-1][1] if done else Path(exc.filename or "")
-                raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=where,
-                                 expected="a writable folder") from None
-            raise
-        for _, _, backup in done:
-            if backup is not None:
-                with contextlib.suppress(OSError):
-                    backup.unlink()
+        move_into_place(moves, self._make_folder)
 
     def _remove_stages(self) -> None:
         for stage in self._stages.values():
@@ -381,8 +341,37 @@ class StagedOutputs:
                           expected="a writable folder")
 
 
+def move_into_place(moves: Iterable[tuple[Path, Path]], make_folder: Callable[[Path], None]) -> None:
+    """Move each ``(staged file, destination)`` into place, all or none: an earlier file at a
+    destination is kept aside until every move succeeded (then deleted); a failure or a stop
+    (``KeyboardInterrupt``) while moving puts the files moved so far back, the earlier files
+    restored. ``make_folder(folder)`` creates a destination's missing folder. An
+    :class:`OSError` becomes an :class:`InputError` naming the destination."""
+    done: list[tuple[Path, Path, Path | None]] = []
+    try:
+        for src, dest in moves:
+            make_folder(dest.parent)
+            earlier = dest.exists() or dest.is_symlink()
+            backup = dest.with_name(f".{dest.name}.nmsm-replaced-{secrets.token_hex(4)}") if earlier else None
+            done.append((src, dest, backup))
+            if backup is not None:
+                os.replace(dest, backup)
+            os.replace(src, dest)
+    except BaseException as exc:
+        _put_back(done)
+        if isinstance(exc, OSError):
+            where = done[-1][1] if done else Path(exc.filename or "")
+            raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=where,
+                             expected="a writable folder") from None
+        raise
+    for _, _, backup in done:
+        if backup is not None:
+            with contextlib.suppress(OSError):
+                backup.unlink()
+
+
 def _put_back(done: list[tuple[Path, Path, Path | None]]) -> None:
-    """Undo the moves of :meth:`StagedOutputs._commit`, last first: each earlier file back
+    """Undo the moves of :func:`move_into_place`, last first: each earlier file back
     in place, each new file removed."""
     for src, dest, backup in reversed(done):
         with contextlib.suppress(OSError):

@@ -175,3 +175,31 @@ def test_a_recorded_rerun_retires_the_earlier_run_and_sets_aside_other_files(tmp
     assert (out / "superseded" / "replaced" / "original.sto").read_text() == "the original tool's"
     assert (out / "notes.txt").read_text() == "the user's"
     assert sorted(second.recorded("mtp")) == [Path("model_mtp.osimx"), Path("original.sto")]
+
+
+@pytest.mark.parametrize("failing_move", [1, 2, 3])
+def test_a_stop_while_moving_a_task_in_leaves_the_earlier_files(failing_move: int, tmp_path: Path,
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """A task's files are moved in all or none: a stop (Ctrl-C) at any of the moves (the earlier
+    a.txt aside, the new a.txt in, the new b.txt in) leaves the earlier run's a.txt and no
+    new file, backup or staging folder."""
+    results = ResultsDirectory(tmp_path / "out")
+    with results.task("first") as stage:
+        (stage / "a.txt").write_text("earlier")
+    real = os.replace
+    calls: list[str] = []
+
+    def replace(src, dst) -> None:
+        calls.append(str(dst))
+        if len(calls) == failing_move:
+            raise KeyboardInterrupt
+        real(src, dst)
+
+    with pytest.raises(KeyboardInterrupt):
+        with monkeypatch.context() as patch:
+            patch.setattr(os, "replace", replace)
+            with results.task("second") as stage:
+                (stage / "a.txt").write_text("new")
+                (stage / "b.txt").write_text("new")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.txt"]
+    assert (tmp_path / "out" / "a.txt").read_text() == "earlier"
