@@ -62,7 +62,9 @@ def _elements(trial: PreprocessTrial) -> dict[str, str]:
     at = f'<Trial name="{trial.name}">'
     return {"--output": "<results_directory>", "--time-pair": f"{at} <time_ranges>", "--prefix": at,
             "--rows": "<rows_per_trial>", "--cutoff": "<cutoff_frequency>", "--model": "<input_model_file>",
-            "--emg-padding-time": "<emg_padding_time>", "--ik/--markers": f"{at} (IKData)"}
+            "--emg-padding-time": "<emg_padding_time>", "--ik/--markers": f"{at} (IKData)",
+            "--ik": f"{at} (IKData)", "--id": f"{at} (IDData)", "--raw-emg": f"{at} (EMGData)",
+            "--grf": f"{at} (GRFData)", "--muscle-analysis": f"{at} (MAData)"}
 
 
 def requests(settings: DataPreprocessingSettings, settings_file: Path) -> list[PreprocessRequest]:

@@ -143,12 +143,15 @@ def check_request(request: PreprocessRequest) -> list[str]:
     """Steps 1-3 of the module docstring; the trial names."""
     out = Path(request.output)
     names = trial_names(request)
-    check_not_input_folder(out, {"--model": request.model, "--raw-emg": request.raw_emg,
-                                 "--emg": request.processed_emg, "--markers": request.markers,
-                                 "--ik-settings": request.ik_settings, "--ik": request.ik,
-                                 "--id": request.inverse_dynamics, "--external-loads": request.external_loads,
-                                 "--grf": request.grf, "--muscle-analysis": request.muscle_analysis},
-                           {"--muscle-analysis": request.muscle_analysis})
+    def named(options: dict[str, Path | None]) -> dict[str, Path | None]:  # as the user gave them
+        return {request.elements.get(option, option): path for option, path in options.items()}
+
+    check_not_input_folder(out, named({"--model": request.model, "--raw-emg": request.raw_emg,
+                                       "--emg": request.processed_emg, "--markers": request.markers,
+                                       "--ik-settings": request.ik_settings, "--ik": request.ik,
+                                       "--id": request.inverse_dynamics, "--external-loads": request.external_loads,
+                                       "--grf": request.grf, "--muscle-analysis": request.muscle_analysis}),
+                           named({"--muscle-analysis": request.muscle_analysis}))
     refuse_earlier_trials(out, names, *planned_files(request, names))
     check_input_times(request)
     return names

@@ -111,7 +111,7 @@ def test_settings_file_stage_checks_first_and_stages(analysis: Path, tmp_path: P
     assert main(["run", str(inside)]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"nmsm: error: {inside}: <results_directory>: the output folder "), err
-    assert "holds the input" in err
+    assert 'holds the input' in err and '(<Trial name="gait"> (IKData))' in err, err  # not the option --ik
     assert _snapshot(analysis) == before
 
 
