@@ -148,12 +148,19 @@ def resolve_path(
         first = candidates[0][0]
         first = first if first.is_absolute() else settings_dir / first
         return (first / relative).resolve()
+    if path.is_absolute():
+        rule = ""
+    elif base is not None:
+        rule = f" (relative paths are relative to {(settings_dir / Path(base)).resolve()})"
+    else:
+        rule = (" (relative paths are looked up in the settings file's folder, then in its parent folder"
+                " and the current working directory)")
     raise InputError(
         f"'{text.strip()}' not found (tried {'; '.join(tried)})",
         file=settings_file,
         line=line,
         element=where,
-        expected=_describe(kind) + " (relative paths are relative to the settings file's folder)",
+        expected=_describe(kind) + rule,
     )
 
 

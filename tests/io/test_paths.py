@@ -101,3 +101,17 @@ def test_names_differing_only_in_case_are_ambiguous(layout: Path) -> None:
 def test_absolute_path(layout: Path) -> None:
     target = layout / "MarkerFiles" / "Knee.trc"
     assert resolve_path(str(target), settings_file=layout / "settings" / "run.xml") == target
+
+
+def test_missing_path_error_states_the_folders_searched(layout: Path) -> None:
+    """The expected-part of the error describes the search the resolver did (settings folder,
+    its parent, the current directory), not only the settings folder; with a base, that base."""
+    settings = layout / "settings" / "run.xml"
+    with pytest.raises(InputError) as info:
+        resolve_path("nothere.osim", settings_file=settings, kind="file")
+    assert "settings file's folder, then in its parent folder and the current working directory" in str(info.value)
+    base = layout / "preprocessed"
+    with pytest.raises(InputError) as info:
+        resolve_path("model.osim", settings_file=settings, base=base)
+    assert f"relative paths are relative to {base.resolve()}" in str(info.value)
+    assert "parent folder" not in str(info.value)
