@@ -144,3 +144,24 @@ def test_jmp_output_model_onto_the_input_is_refused_before_solving(shared_data: 
         jmp_run.run_settings(settings, quiet=True)
     assert "<output_model_file>" in str(info.value)
     assert Path(model).read_bytes() == before
+
+
+def test_treatment_run_over_the_original_results_sets_them_aside(shared_data: Path, tmp_path: Path) -> None:
+    """Torque TO V1 run as the tutorial gives it writes into the tutorial's own
+    ``TorqueTOResultsV1``: the original's files it replaces are moved to
+    ``superseded/replaced`` with a warning (were overwritten silently), and a second run
+    retires the first run's files, not the original's."""
+    from nmsm.tools.treatment.run import run_settings
+
+    tutorial = _writable_copy(shared_data / "treatment" / "torque_kick_tutorial", tmp_path / "kick")
+    results = tutorial / "CompletedSettingsFiles" / "TorqueTOResultsV1"
+    original = _tree(results)
+    with pytest.warns(UserWarning, match="were not written by it; moved to"):
+        run_settings(tutorial / "CompletedSettingsFiles" / "TorqueTOSettingsV1.xml", print_level=0)
+    aside = results / "superseded" / "replaced"
+    assert {name: data for name, data in _tree(aside).items()} == original  # every original file, unchanged
+    first = (results / "drive_kick1_states.sto").read_bytes()
+    with pytest.warns(UserWarning, match="files of the earlier drive_kick1 run there were moved to"):
+        run_settings(tutorial / "CompletedSettingsFiles" / "TorqueTOSettingsV1.xml", print_level=0)
+    assert _tree(aside) == original
+    assert (results / "superseded" / "drive_kick1_states.sto").read_bytes() == first

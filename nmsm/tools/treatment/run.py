@@ -184,9 +184,14 @@ def _check_results_apart(settings: Any, options: TreatmentOptions, prepared: Pre
 
 
 def _results_directory(settings: Any, options: TreatmentOptions, inputs: list[Path]) -> ResultsDirectory:
+    """The run's results folder, recorded under the trial name: a rerun moves the earlier
+    run's files of the trial into ``superseded/``, and a file it replaces that no run of the
+    trial wrote (e.g. the original tool's results in a tutorial folder) into
+    ``superseded/replaced/``, with a warning (:mod:`nmsm.core.results`)."""
     path = Path(options.results_directory or settings.results_directory)
     try:
-        return ResultsDirectory(path, inputs=inputs)
+        return ResultsDirectory(path, inputs=inputs, record=settings.trial_name,
+                                settings_file=settings.settings_file)
     except OSError as exc:
         raise InputError(f"cannot create the results folder {path}: {exc.strerror or exc}",
                          file=settings.settings_file, element="<results_directory>",
@@ -275,7 +280,7 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
         from nmsm.tools.treatment.design import parameter_tables, write_parameter_solution
         from nmsm.tools.treatment.outputs import write_solution
 
-        with results.task(trial, record=trial) as stage:
+        with results.task(trial) as stage:
             files = write_solution(stage, tsol, summary=summary, extra_tables=parameter_tables(prepared, tsol))
             files += write_parameter_solution(stage, prepared, tsol)
             if (Path(results.path) / Path(path).name).resolve() != Path(path).resolve():  # not the settings itself
