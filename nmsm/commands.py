@@ -6,6 +6,7 @@ import argparse
 import io
 import os
 import sys
+from pathlib import Path
 from typing import Any
 
 
@@ -15,7 +16,10 @@ def _run(args: argparse.Namespace) -> int:
     options = {}
     if args.results_directory:
         options["results_directory"] = args.results_directory
-    run_settings_file(args.settings, **options)
+    outcome = run_settings_file(args.settings, **options)
+    where = outcome if isinstance(outcome, Path) else getattr(outcome, "results_directory", None)
+    if where is not None:  # every tool says where its results went (some print nothing else)
+        print(f"nmsm: results in {where}")
     return 0
 
 

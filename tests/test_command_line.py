@@ -20,3 +20,16 @@ def test_progress_interval_option():
     assert parser.parse_args(["plugins"]).progress == 10.0
     assert parser.parse_args(["--progress", "0", "plugins"]).progress == 0.0
     assert parser.parse_args(["--progress", "2.5", "plugins"]).progress == 2.5
+
+
+def test_run_says_where_the_results_went(shared_data, tmp_path, capsys):
+    """``nmsm run`` ends with the results folder for every tool (MTP printed nothing at all)."""
+    import warnings
+
+    from nmsm.cli import main
+
+    settings = shared_data / "mtp" / "uf_subject3_tutorial" / "CompletedSettingsFiles" / "MTPSettingsV3.xml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["--progress", "0", "run", str(settings), "-o", str(tmp_path / "mtp")]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"nmsm: results in {tmp_path / 'mtp'}"
