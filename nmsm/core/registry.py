@@ -209,7 +209,11 @@ class Registry:
                 f"{kind} '{name}' is not allowed in {TOOL_NAMES.get(tool, tool)} ({tool}); "
                 f"it is accepted by: {accepted}. Valid {kind} names for {tool}: {valid}"
             )
-        raise RegistryError(f"unknown {kind} '{name}' for {tool}. Valid {kind} names for {tool}: {valid}")
+        close = difflib.get_close_matches(name, self.names(kind, tool), n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        raise RegistryError(f"unknown {kind} '{name}' for {tool}{hint}. Valid {kind} names for {tool}: {valid}. "
+                            "A name from a plugin package needs that package installed in this environment "
+                            "('nmsm plugins' lists what is installed)")
 
 
 @attrs.frozen

@@ -81,8 +81,11 @@ def test_disable_plugins_env(extra_path: Path, monkeypatch) -> None:
 def test_unknown_and_disallowed_names_list_valid_ones(extra_path: Path) -> None:
     _fake_distribution(extra_path, "fake-plugin-a", "fake_plugin_a", _TERM_MODULE.format(name="fancy_goal"))
     registry = build_registry()
-    with pytest.raises(RegistryError, match="unknown cost 'no_such_term' for DO. Valid cost names for DO: .*fancy_goal"):
+    with pytest.raises(RegistryError, match="unknown cost 'no_such_term' for DO. Valid cost names for DO: .*fancy_goal"
+                                            r".*needs that package installed.*'nmsm plugins' lists"):
         registry.get("cost", "no_such_term", "DO")
+    with pytest.raises(RegistryError, match=r"unknown cost 'fancy_gaol' for DO \(did you mean 'fancy_goal'\?\)"):
+        registry.get("cost", "fancy_gaol", "DO")
     with pytest.raises(RegistryError, match="not allowed in Tracking Optimization .*accepted by: DO"):
         registry.get("cost", "fancy_goal", "TO")
 
