@@ -63,10 +63,15 @@ def opensim_available() -> bool:
     global _AVAILABLE
     if _AVAILABLE is None:
         try:
-            proc = subprocess.run(
-                [opensim_python(), "-c", "import opensim"],
-                capture_output=True, timeout=120, cwd=tempfile.gettempdir(),
-            )
+            with subprocess.Popen([opensim_python(), "-c", "import opensim"], stdin=subprocess.DEVNULL,
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                  cwd=tempfile.gettempdir()) as proc:
+                try:
+                    proc.wait(timeout=120)
+                except BaseException:  # timed out or stopped (Ctrl-C): killed and reaped, none left running
+                    proc.kill()
+                    proc.wait()
+                    raise
             _AVAILABLE = proc.returncode == 0
         except (OSError, subprocess.TimeoutExpired):
             _AVAILABLE = False
