@@ -137,8 +137,9 @@ class ResultsDirectory:
                     expected="another results folder or output name",
                 )
 
-    def _remove_if_unused(self) -> None:
-        """Remove the folders :meth:`ensure` created while they are still empty."""
+    def remove_if_unused(self) -> None:
+        """Remove the folders :meth:`ensure` created while they are still empty (none once a
+        task finished): for a run that used the folder outside a task and then stopped."""
         for folder in self._created:
             try:
                 folder.rmdir()
@@ -162,12 +163,12 @@ class ResultsDirectory:
             yield stage
         except BaseException:
             shutil.rmtree(stage, ignore_errors=True)
-            self._remove_if_unused()
+            self.remove_if_unused()
             raise
         try:
             written = self._commit(stage)
         except BaseException:
-            self._remove_if_unused()
+            self.remove_if_unused()
             raise
         finally:
             shutil.rmtree(stage, ignore_errors=True)

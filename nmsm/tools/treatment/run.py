@@ -236,6 +236,8 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
     finally:
         if log_dir is not None:
             shutil.rmtree(log_dir, ignore_errors=True)
+        if results is not None:  # a stop or failure before any result leaves no empty folder
+            results.remove_if_unused()
 
 
 def _not_finite(solution: Solution) -> str:
