@@ -115,6 +115,9 @@ class MuscleControllerSettings:
     epsilon: float = setting("epsilon", kind="number", default=1e-4, check=positive, doc="Surrogate regularization")
     load_surrogate_model: bool = setting("load_surrogate_model", kind="boolean", default=False, doc="Load surrogate")
     save_surrogate_model: bool = setting("save_surrogate_model", kind="boolean", default=False, doc="Save surrogate")
+    surrogate_model_file_name: str = setting(
+        "surrogate_model_file_name", kind="text", default="surrogateMuscles.mat",
+        doc="Saved surrogate, next to the settings file (kept as JSON: the extension becomes .json)")
     maximum_shortening_velocity_multiplier: float = setting(
         "maximum_shortening_velocity_multiplier", kind="number", default=10.0, check=positive,
         doc="Maximum shortening velocity (optimal fiber lengths per second)")
@@ -150,6 +153,10 @@ class SynergyControllerSettings:
     )
     save_surrogate_model: bool = setting(
         "save_surrogate_model", kind="boolean", default=False, tool_fallback=True, doc="Save the fitted surrogate model"
+    )
+    surrogate_model_file_name: str = setting(
+        "surrogate_model_file_name", kind="text", default="surrogateMuscles.mat", tool_fallback=True,
+        doc="Saved surrogate, next to the settings file (kept as JSON: the extension becomes .json)",
     )
     epsilon: float = setting(
         "epsilon",

@@ -40,9 +40,12 @@ _SURROGATE_CACHE: dict[tuple[Any, ...], SurrogateModel] = {}
 
 def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLike[str] | str,
                    coordinates: Sequence[str], *, degree: int, epsilon: float, load: bool = False,
-                   save: bool = False, settings_file: os.PathLike[str] | str | None = None) -> SurrogateModel:
+                   save: bool = False, settings_file: os.PathLike[str] | str | None = None,
+                   file_name: str = "surrogateMuscles.mat") -> SurrogateModel:
     """Fit (or load/save, as the settings ask) the surrogate of the synergy controller;
-    fits are cached per process (same data, coordinates, degree and epsilon)."""
+    fits are cached per process (same data, coordinates, degree and epsilon). ``file_name``:
+    the settings' ``<surrogate_model_file_name>``, kept as JSON next to the settings file
+    (extension replaced by ``.json``, :mod:`nmsm.tools.surrogate.settings`)."""
     from nmsm.tools.surrogate.settings import SurrogateSettings
     from nmsm.tools.surrogate.tool import surrogate_from_settings
 
@@ -52,7 +55,7 @@ def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLi
     base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
     settings = SurrogateSettings(model_file=Path(model_file), data_directory=Path(data_directory),
                                  coordinates=tuple(coordinates), epsilon=epsilon, degree=degree, load=load, save=save,
-                                 model_path=base / "surrogateMuscles.json",
+                                 model_path=base / Path(file_name.replace("\\", "/")).with_suffix(".json"),
                                  settings_file=Path(settings_file) if settings_file else None)
     model = surrogate_from_settings(settings)
     _SURROGATE_CACHE[key] = model

@@ -79,3 +79,42 @@ def test_strength_modifier_scales_muscle_moments(shared_data: Path) -> None:
     strong = _at_start(plain.built, plain.built.context.controller_load(load))
     halved = _at_start(weak.built, weak.built.context.controller_load(load))
     assert np.allclose(halved, 0.5 * strong, rtol=1e-10, atol=1e-12)
+
+
+def test_surrogate_model_file_name_is_honoured(shared_data: Path, tmp_path: Path) -> None:
+    """``<surrogate_model_file_name>`` names the saved surrogate (as JSON next to the settings
+    file): saved under that name, then loaded from it without a refit (it was always
+    ``surrogateMuscles.json`` in the treatment tools)."""
+    import shutil
+
+    from nmsm.tools.treatment.muscles import _SURROGATE_CACHE
+
+    folder = tmp_path / "kick"
+    shutil.copytree(_folder(shared_data), folder)
+    for path in [folder, *folder.rglob("*")]:
+        path.chmod(path.stat().st_mode | 0o200)
+    original = folder / "CompletedSettingsFiles" / "SynergyTOSettingsV1.xml"
+    text = original.read_text()
+    assert "<load_surrogate_model>true</load_surrogate_model>" in text
+    saving = original.with_name("save.xml")
+    saving.write_text(text.replace("<load_surrogate_model>true</load_surrogate_model>",
+                                   "<load_surrogate_model>false</load_surrogate_model>")
+                      .replace("<save_surrogate_model>false</save_surrogate_model>",
+                               "<save_surrogate_model>true</save_surrogate_model>"
+                               "<surrogate_model_file_name>kickSurrogate.mat</surrogate_model_file_name>"))
+    loading = original.with_name("load.xml")
+    loading.write_text(text.replace("<save_surrogate_model>false</save_surrogate_model>",
+                                    "<save_surrogate_model>false</save_surrogate_model>"
+                                    "<surrogate_model_file_name>kickSurrogate.mat</surrogate_model_file_name>"))
+    _SURROGATE_CACHE.clear()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        settings, solver = load_settings(saving)
+        prepare(settings, solver, TreatmentOptions())
+    saved = folder / "CompletedSettingsFiles" / "kickSurrogate.json"
+    assert saved.is_file() and not (folder / "CompletedSettingsFiles" / "surrogateMuscles.json").exists()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        settings, solver = load_settings(loading)
+        prepare(settings, solver, TreatmentOptions())
+    assert not [w for w in caught if "fitting a new surrogate" in str(w.message)]
