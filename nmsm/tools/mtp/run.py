@@ -9,9 +9,15 @@ Steps (the original's ``MuscleTendonPersonalizationTool``):
    length scale factors are absorbed into l_o, l_ts;
 4. results written per §4.6 (:mod:`nmsm.tools.mtp.outputs`), staged, plus the settings file.
 
+A stop (Ctrl-C) during task k+1 writes the results after task k, as step 4 would, into
+``<results>/stopped_after_task_<k>/`` (``mtpSummary.txt`` says so), and nothing at the top of
+the results folder; a later run retires that folder into ``superseded/`` with its own files.
+
 ``options``: ``results_directory`` (write elsewhere than the settings say),
 ``print_level`` (IPOPT, default 0), ``max_iterations`` (override), ``tolerance`` (IPOPT
-``tol``, default 1e-6), ``emg_spline_stride`` (default 4), ``verbose`` (progress lines).
+``tol``, default 1e-6), ``emg_spline_stride`` (default 4), ``verbose`` (progress lines),
+``keep_finished_on_stop`` (default true; the pipeline, which discards a stopped stage's
+folder, passes false).
 """
 
 from __future__ import annotations
@@ -263,10 +269,15 @@ def output_osimx_name(setup: MtpSetup) -> str:
     return f"{base}_mtp.osimx"
 
 
-def write_results(outcome: MtpOutcome, results: ResultsDirectory) -> None:
+def write_results(outcome: MtpOutcome, results: ResultsDirectory, folder: str = "",
+                  note: str | None = None) -> None:
+    """Write ``outcome`` into ``results`` (into its subfolder ``folder`` if given) as one
+    task; ``note``: a first line of ``mtpSummary.txt``."""
     setup = outcome.setup
     trial_times = [t.time for t in outcome.data.trials]
-    with results.task("mtp_results") as stage:
+    with results.task("mtp_results") as staging:
+        stage = staging / folder
+        stage.mkdir(parents=True, exist_ok=True)
         outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)
         outputs.parameter_file(stage, outcome.state, outcome.final_muscles, setup.model_muscles)
         if setup.passive_trials:
@@ -282,8 +293,9 @@ def write_results(outcome: MtpOutcome, results: ResultsDirectory) -> None:
             write_max_isometric_force=outcome.mtli is not None and mtli_options(setup).update_max_isometric_force,
             base=setup.input_osimx,
         )
-        lines = [f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; {t.wall_time:.2f} s"
-                 for t in outcome.tasks]
+        lines = [note] if note else []
+        lines += [f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; {t.wall_time:.2f} s"
+                  for t in outcome.tasks]
         for t in outcome.tasks:
             lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
         lines.append(f"total wall time: {outcome.wall_time:.2f} s")
@@ -299,6 +311,7 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
     print_level = int(options.pop("print_level", 0))
     max_iterations = options.pop("max_iterations", None)
     tolerance = float(options.pop("tolerance", 1e-6))
+    keep_stopped = bool(options.pop("keep_finished_on_stop", True))
     if options:
         raise TypeError(f"unknown MTP options: {', '.join(options)}")
     setup = prepare(settings_file, emg_spline_stride=stride)
@@ -319,11 +332,44 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
     start_data, mtli = initialize_lengths(setup)
     if mtli is not None:
         _log(verbose, f"MTLI: {mtli.solution.status}, cost {mtli.solution.cost:.6g}")
-    data, state, tasks = solve_tasks(setup, start_data, print_level=print_level, max_iterations=max_iterations,
-                                     tolerance=tolerance, verbose=verbose)
+    finished: list[tuple[MtpData, MtpState, TaskOutcome]] = []
+    try:
+        data, state, tasks = solve_tasks(setup, start_data, print_level=print_level, max_iterations=max_iterations,
+                                         tolerance=tolerance, verbose=verbose,
+                                         on_task=lambda k, d, s, o: finished.append((d, s, o)))
+    except KeyboardInterrupt:
+        if keep_stopped:
+            _keep_finished_tasks(setup, start_data, mtli, finished, results, start)
+        raise
     plain, synx = evaluate(data, state)
     outcome = MtpOutcome(setup, start_data, data, state, mtli, tuple(tasks), plain, synx, results.path,
                          time.perf_counter() - start)
     write_results(outcome, results)
     results.copy_in(settings_file, Path(settings_file).name)
     return outcome
+
+
+#: subfolder of the results folder for the tasks finished before a stop (``{k}``: last one)
+STOPPED_FOLDER = "stopped_after_task_{k}"
+
+
+def _keep_finished_tasks(setup: MtpSetup, start_data: MtpData, mtli: MtliResult | None,
+                         finished: Sequence[tuple[MtpData, MtpState, TaskOutcome]], results: ResultsDirectory,
+                         start: float) -> None:
+    """A stop (Ctrl-C) during task k+1: write the results after task k (as the tool would
+    after its last task) into ``<results>/stopped_after_task_<k>/``, so finished tasks are
+    not lost; nothing when no task finished. Recorded with the run, so a rerun retires it."""
+    if not finished:
+        return
+    data, state, _ = finished[-1]
+    data, state = absorb_length_scales(data, state)
+    plain, synx = evaluate(data, state)
+    tasks = tuple(outcome for _, _, outcome in finished)
+    outcome = MtpOutcome(setup, start_data, data, state, mtli, tasks, plain, synx, results.path,
+                         time.perf_counter() - start)
+    k = len(finished)
+    folder = STOPPED_FOLDER.format(k=k)
+    write_results(outcome, results, folder,
+                  note=f"stopped during task {k + 1} of {len(setup.tasks)}: results after task {k}")
+    print(f"nmsm: MTP stopped during task {k + 1}; the results after task {k} are in {results.path / folder}",
+          file=sys.stderr)

@@ -142,7 +142,7 @@ _BUILT_IN = (
               "nmsm.io.settings.mtp:MuscleTendonPersonalizationSettings", "nmsm.tools.mtp.run:run_settings",
               _OUT + "mtp_outputs", requires=("model", "data_directory"), uses=("osimx",),
               produces=("osimx", "mtp_results"), wires=_PERSONALIZATION_WIRES, validate=_CHECK + "mtp",
-              has_terms=True),
+              has_terms=True, run_options={"keep_finished_on_stop": False}),
     StageKind("ncp", "Neural Control Personalization", "NeuralControlPersonalizationTool", 50,
               "nmsm.io.settings.ncp:NeuralControlPersonalizationSettings", "nmsm.tools.ncp.run:run_settings",
               _OUT + "ncp_outputs", requires=("model", "data_directory"), uses=("osimx", "mtp_results"),
