@@ -6,7 +6,10 @@ build each enabled foot (two-segment foot model, springs, experimental kinematic
 reactions on its window); optionally initialize the resting spring length; run the enabled
 tasks in index order, each starting from the previous solution; write the results
 (:mod:`nmsm.tools.gcp.outputs`) through a staged results folder and copy the settings file
-there.
+there. A stop (Ctrl-C) during task k+1 writes the results after task k, as the run would,
+into ``<results>/stopped_after_task_<k>/`` (with ``feet="separately"``: only when every
+group has a finished task), nothing at the top of the results folder; a later run retires
+that folder into ``superseded/``.
 
 Options:
 
@@ -20,13 +23,16 @@ Options:
                        :mod:`nmsm.tools.gcp.spring_grid`);
 ``max_iterations``     override the settings' iteration limit of every task;
 ``update_motion``      re-run IK with the modeled foot markers (default True);
-``verbose``            print each solver iteration.
+``verbose``            print each solver iteration;
+``keep_finished_on_stop`` default True (the pipeline, which discards a stopped stage's
+                       folder, passes False).
 """
 
 from __future__ import annotations
 
+import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -98,8 +104,10 @@ def task_terms(settings: GroundContactPersonalizationSettings) -> list[list[Any]
 
 
 def optimize_group(settings: GroundContactPersonalizationSettings, feet: list[FootInputs], *,
-                   max_iterations: int | None = None, verbose: bool = False) -> GroupResult:
-    """Initialize and run every task for ``feet`` optimized together."""
+                   max_iterations: int | None = None, verbose: bool = False,
+                   on_task: Callable[[GroupResult], None] | None = None) -> GroupResult:
+    """Initialize and run every task for ``feet`` optimized together; ``on_task`` gets the
+    group as it stands after each finished task."""
     check_equal_spring_counts(feet, settings.settings_file)
     terms_per_task = task_terms(settings)
     state = GcpState.initial(settings, feet)
@@ -115,16 +123,24 @@ def optimize_group(settings: GroundContactPersonalizationSettings, feet: list[Fo
         state = updated_state(state, solution, len(feet))
         solutions.append(solution)
         seconds.append(time.perf_counter() - start)
+        if on_task is not None:
+            on_task(_group_result(feet, state, solutions, seconds))
+    return _group_result(feet, state, solutions, seconds)
+
+
+def _group_result(feet: list[FootInputs], state: GcpState, solutions: list[Solution],
+                  seconds: list[float]) -> GroupResult:
     design = state.design()
     values = [foot_values(foot, design, i) for i, foot in enumerate(feet)]
-    return GroupResult(feet, state, solutions, values, seconds)
+    return GroupResult(feet, state, list(solutions), values, list(seconds))
 
 
 def run_log(settings: GroundContactPersonalizationSettings, groups: Sequence[GroupResult],
-            errors: dict[int, dict[str, float]]) -> str:
+            errors: dict[int, dict[str, float]], note: str | None = None) -> str:
     """The run's summary (the original's ``commandWindowOutput.txt``): each task's solver
-    summary and time, the final properties and the error table."""
-    lines = [f"Ground Contact Personalization: {settings.settings_file}"]
+    summary and time, the final properties and the error table (``note``: a line after the
+    title)."""
+    lines = [f"Ground Contact Personalization: {settings.settings_file}"] + ([note] if note else [])
     for g, group in enumerate(groups, start=1):
         feet = ", ".join(str(f.index) for f in group.feet)
         lines.append(f"group {g} (feet {feet}):")
@@ -162,7 +178,8 @@ def load_feet(settings: GroundContactPersonalizationSettings, *, spring_location
 
 def run_settings(path: str | Path, *, results_directory: str | Path | None = None, feet: str = "together",
                  spring_locations: str | Path | None = None, max_iterations: int | None = None,
-                 update_motion: bool = True, verbose: bool = False) -> GcpRunResult:
+                 update_motion: bool = True, verbose: bool = False,
+                 keep_finished_on_stop: bool = True) -> GcpRunResult:
     """Run GCP from a settings file (module docstring)."""
     start = time.perf_counter()
     if feet not in FEET_MODES:
@@ -183,12 +200,46 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
     all_feet, casadi_model, motion, grf, osimx = load_feet(
         settings, spring_locations=Path(spring_locations) if spring_locations is not None else None)
     groups_inputs = [all_feet] if feet == "together" else [[f] for f in all_feet]
-    groups = [optimize_group(settings, group, max_iterations=max_iterations, verbose=verbose)
-              for group in groups_inputs]
-    errors = {foot.index: report.rms_errors(foot, values)
-              for group in groups for foot, values in zip(group.feet, group.values)}
-    with results.task("gcp") as stage:
-        write_results(stage, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
-        (stage / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors), encoding="utf-8")
+    groups: list[GroupResult] = []
+    latest: list[GroupResult] = []  # the group in progress, after its last finished task
+
+    def remember(group: GroupResult) -> None:
+        latest[:] = [group]
+
+    try:
+        for group in groups_inputs:
+            latest.clear()
+            groups.append(optimize_group(settings, group, max_iterations=max_iterations, verbose=verbose,
+                                         on_task=remember))
+    except KeyboardInterrupt:
+        finished = groups + latest
+        if keep_finished_on_stop and len(finished) == len(groups_inputs):  # every foot has a finished task
+            k = len(finished[-1].solutions)
+            folder = STOPPED_FOLDER.format(k=k)
+            _write(results, folder, settings, finished, casadi_model, motion, grf, osimx, update_motion,
+                   note=f"stopped during task {k + 1} of {len(settings.tasks)}: results after task {k}")
+            print(f"nmsm: GCP stopped during task {k + 1}; the results after task {k} are in "
+                  f"{results.path / folder}", file=sys.stderr)
+        raise
+    errors = _write(results, "", settings, groups, casadi_model, motion, grf, osimx, update_motion)
     results.copy_in(path)
     return GcpRunResult(settings, groups, results.path, errors, time.perf_counter() - start)
+
+
+#: subfolder of the results folder for the tasks finished before a stop (``{k}``: last one)
+STOPPED_FOLDER = "stopped_after_task_{k}"
+
+
+def _write(results: ResultsDirectory, folder: str, settings: GroundContactPersonalizationSettings,
+           groups: list[GroupResult], casadi_model: CasadiModel, motion: Any, grf: Any, osimx: OsimxModel | None,
+           update_motion: bool, note: str | None = None) -> dict[int, dict[str, float]]:
+    """Write the groups' results (into ``folder`` of the results folder if given) as one
+    task; returns the error table."""
+    errors = {foot.index: report.rms_errors(foot, values)
+              for group in groups for foot, values in zip(group.feet, group.values)}
+    with results.task("gcp") as staging:
+        stage = staging / folder
+        stage.mkdir(parents=True, exist_ok=True)
+        write_results(stage, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
+        (stage / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors, note), encoding="utf-8")
+    return errors
