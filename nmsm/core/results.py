@@ -23,7 +23,13 @@ a rerun never mixes with an earlier run's files and never deletes a file it did 
 
 A task's files are moved in all or none (:func:`nmsm.io.output_file.move_into_place`): a
 failure or a stop while moving puts back the files moved so far and the earlier files they
-replaced.
+replace in place, and removes the folders it created. (Files a recorded run has already moved
+into ``superseded/`` before that, the earlier run's and the replaced ones, stay there.)
+
+A run stopped after some of its tasks (MTP, GCP: each task refines one result) writes the
+results after its last finished task with :meth:`ResultsDirectory.stopped_task` into
+``stopped_after_task_<k>/``: the earlier complete run's files stay where they are; the next
+run that finishes a task retires that folder into ``superseded/`` with the earlier run's files.
 
 The folder is created when the first task starts, and removed again if that task fails and
 leaves it empty, so a run refused for bad input leaves no empty results folder behind.
@@ -46,6 +52,8 @@ from nmsm.io.output_file import move_into_place
 
 #: folder (inside the results folder) that retired files of an earlier run are moved into
 SUPERSEDED = "superseded"
+#: folder of the results after the last finished task of a stopped run (``{k}``: that task)
+STOPPED_FOLDER = "stopped_after_task_{k}"
 _RECORD = ".nmsm-outputs-{}.txt"
 
 
@@ -152,11 +160,12 @@ class ResultsDirectory:
         self._inputs.update(Path(p).resolve() for p in paths)
 
     @contextlib.contextmanager
-    def task(self, name: str = "task", *, record: str | None = None) -> Iterator[Path]:
+    def task(self, name: str = "task", *, record: str | None = None, part_of_run: bool = True) -> Iterator[Path]:
         """Stage a task's files; move them into the results folder when the block ends normally.
 
         ``record``: list the files in that record, retiring those of the earlier record that
-        were not written again (module docstring).
+        were not written again (module docstring). ``part_of_run`` False: the run's record
+        (``ResultsDirectory(record=...)``) is neither begun nor extended by this task.
         """
         stage = Path(tempfile.mkdtemp(prefix=f".staging-{_safe(name)}-", dir=self.ensure()))
         try:
@@ -166,14 +175,14 @@ class ResultsDirectory:
             self.remove_if_unused()
             raise
         try:
-            written = self._commit(stage)
+            written = self._commit(stage, part_of_run)
         except BaseException:
             self.remove_if_unused()
             raise
         finally:
             shutil.rmtree(stage, ignore_errors=True)
         self._created = []
-        if self._record is not None:
+        if self._record is not None and part_of_run:
             self._run_files.extend(p for p in written if p not in self._run_files)
             _write_record(self.path / _RECORD.format(_safe(self._record)), self._run_files)
         if record is not None:
@@ -181,7 +190,19 @@ class ResultsDirectory:
             self._move(record, [p for p in self.recorded(record) if p not in again], SUPERSEDED)
             _write_record(self.path / _RECORD.format(_safe(record)), written)
 
-    def _commit(self, stage: Path) -> list[Path]:
+    @contextlib.contextmanager
+    def stopped_task(self, last_finished: int) -> Iterator[Path]:
+        """Stage the results after task ``last_finished`` of a stopped run into
+        ``<results>/stopped_after_task_<k>/`` (yields that folder inside the staging folder;
+        module docstring). Needs the run's record."""
+        if self._record is None:
+            raise ValueError("stopped_task needs ResultsDirectory(record=...)")
+        with self.task("stopped", record=_stopped_record(self._record), part_of_run=False) as stage:
+            folder = stage / STOPPED_FOLDER.format(k=last_finished)
+            folder.mkdir()
+            yield folder
+
+    def _commit(self, stage: Path, part_of_run: bool = True) -> list[Path]:
         files = [p for p in sorted(stage.rglob("*")) if p.is_file()]
         for src in files:
             dest = (self.path / src.relative_to(stage)).resolve()
@@ -191,11 +212,10 @@ class ResultsDirectory:
                     "or output name",
                     file=dest,
                 )
-        if self._record is not None:
+        if self._record is not None and part_of_run:
             self._begin_run()
             self._set_aside([src.relative_to(stage) for src in files])
-        move_into_place([(src, self.path / src.relative_to(stage)) for src in files],
-                        lambda folder: folder.mkdir(parents=True, exist_ok=True))
+        move_into_place([(src, self.path / src.relative_to(stage)) for src in files])
         return [src.relative_to(stage) for src in files]
 
     def _begin_run(self) -> None:
@@ -203,7 +223,7 @@ class ResultsDirectory:
         if self._begun:
             return
         self._begun = True
-        moved = self.retire(self._record)
+        moved = self.retire(self._record) + self.retire(_stopped_record(self._record))
         if moved:
             warnings.warn(f"{self.path}: the {len(moved)} files of the earlier {self._record} run there were moved "
                           f"to {self.path / SUPERSEDED}", stacklevel=4)
@@ -286,6 +306,11 @@ class ResultsDirectory:
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, target)
         return self.path / relative
+
+
+def _stopped_record(record: str) -> str:
+    """The record of a stopped run's :meth:`ResultsDirectory.stopped_task` files."""
+    return f"{record}-stopped"
 
 
 def _safe(name: str) -> str:

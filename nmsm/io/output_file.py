@@ -280,20 +280,7 @@ class StagedOutputs:
 
     def _make_folder(self, folder: Path) -> None:
         """Create ``folder`` and its missing parents, remembering them for :meth:`_discard`."""
-        missing = []
-        probe = folder
-        while not probe.exists() and not probe.is_symlink() and probe != probe.parent:
-            missing.append(probe)
-            probe = probe.parent
-        for path in reversed(missing):
-            try:
-                path.mkdir()
-            except FileExistsError:
-                continue
-            except OSError as exc:
-                raise InputError(f"cannot create the output folder: {exc.strerror or exc}", file=path,
-                                 expected="a writable folder") from None
-            self._created.append(path)
+        self._created += _make_missing_folders(folder)
 
     def _staged_files(self) -> list[tuple[Path, Path]]:
         """``(staged file, destination)`` of every staged file."""
@@ -305,16 +292,13 @@ class StagedOutputs:
         moving puts the files moved so far back (the earlier files restored)."""
         moves = self._staged_files()
         for src, dest in moves:
-            if dest.is_dir() and not dest.is_symlink():
-                raise InputError("cannot write the output file: a folder of that name exists", file=dest,
-                                 expected="a file name that is not a folder")
             try:
                 _flush_to_disk(src)
                 os.chmod(src, _mode_for(dest))
             except OSError as exc:
                 raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=dest,
                                  expected="a writable folder") from None
-        move_into_place(moves, self._make_folder)
+        move_into_place(moves)
 
     def _remove_stages(self) -> None:
         for stage in self._stages.values():
@@ -341,16 +325,26 @@ class StagedOutputs:
                           expected="a writable folder")
 
 
-def move_into_place(moves: Iterable[tuple[Path, Path]], make_folder: Callable[[Path], None]) -> None:
+def move_into_place(moves: Iterable[tuple[Path, Path]]) -> None:
     """Move each ``(staged file, destination)`` into place, all or none: an earlier file at a
-    destination is kept aside until every move succeeded (then deleted); a failure or a stop
-    (``KeyboardInterrupt``) while moving puts the files moved so far back, the earlier files
-    restored. ``make_folder(folder)`` creates a destination's missing folder. An
-    :class:`OSError` becomes an :class:`InputError` naming the destination."""
+    destination is kept aside until every move succeeded (then deleted); missing destination
+    folders are created. A failure or a stop (``KeyboardInterrupt``) while moving puts the
+    files moved so far back, the earlier files restored, and removes the folders it created.
+    A destination that is a folder is refused before anything moves. An :class:`OSError`
+    becomes an :class:`InputError` naming the destination (or folder) that failed."""
+    moves = list(moves)
+    for _, dest in moves:
+        if dest.is_dir() and not dest.is_symlink():
+            raise InputError("cannot write the output file: a folder of that name exists", file=dest,
+                             expected="a file name that is not a folder")
     done: list[tuple[Path, Path, Path | None]] = []
+    created: list[Path] = []
+    current = Path()
     try:
         for src, dest in moves:
-            make_folder(dest.parent)
+            current = dest.parent
+            created += _make_missing_folders(dest.parent)
+            current = dest
             earlier = dest.exists() or dest.is_symlink()
             backup = dest.with_name(f".{dest.name}.nmsm-replaced-{secrets.token_hex(4)}") if earlier else None
             done.append((src, dest, backup))
@@ -359,15 +353,40 @@ def move_into_place(moves: Iterable[tuple[Path, Path]], make_folder: Callable[[P
             os.replace(src, dest)
     except BaseException as exc:
         _put_back(done)
+        for folder in reversed(created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
         if isinstance(exc, OSError):
-            where = done[-1][1] if done else Path(exc.filename or "")
-            raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=where,
+            raise InputError(f"cannot write the output file: {exc.strerror or exc}", file=current,
                              expected="a writable folder") from None
         raise
     for _, _, backup in done:
         if backup is not None:
             with contextlib.suppress(OSError):
                 backup.unlink()
+
+
+def _make_missing_folders(folder: Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; returns those created, outermost first."""
+    missing = []
+    probe = folder
+    while not probe.exists() and not probe.is_symlink() and probe != probe.parent:
+        missing.append(probe)
+        probe = probe.parent
+    created: list[Path] = []
+    for path in reversed(missing):
+        try:
+            path.mkdir()
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            for folder in reversed(created):
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
+            raise InputError(f"cannot create the output folder: {exc.strerror or exc}", file=path,
+                             expected="a writable folder") from None
+        created.append(path)
+    return created
 
 
 def _put_back(done: list[tuple[Path, Path, Path | None]]) -> None:

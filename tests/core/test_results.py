@@ -203,3 +203,54 @@ def test_a_stop_while_moving_a_task_in_leaves_the_earlier_files(failing_move: in
                 (stage / "b.txt").write_text("new")
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.txt"]
     assert (tmp_path / "out" / "a.txt").read_text() == "earlier"
+
+
+def test_a_stop_while_moving_leaves_no_new_folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A recorded run's task with files in new sub-folders, stopped at its second move: the
+    sub-folders it created are removed again (none was left empty)."""
+    results = ResultsDirectory(tmp_path / "out", record="tool")
+    with results.task("first") as stage:
+        (stage / "kept.txt").write_text("earlier")
+    real = os.replace
+    calls: list[str] = []
+
+    def replace(src, dst) -> None:
+        calls.append(str(dst))
+        if len(calls) == 3:  # after the earlier run's file was retired and deep/a.txt moved
+            raise KeyboardInterrupt
+        real(src, dst)
+
+    with pytest.raises(KeyboardInterrupt):
+        with monkeypatch.context() as patch:
+            patch.setattr(os, "replace", replace)
+            with ResultsDirectory(tmp_path / "out", record="tool").task("second") as stage:
+                (stage / "deep" / "er").mkdir(parents=True)
+                (stage / "deep" / "er" / "a.txt").write_text("new")
+                (stage / "z.txt").write_text("new")
+    assert not (tmp_path / "out" / "deep").exists()
+    assert not [p for p in (tmp_path / "out").iterdir() if p.name.startswith(".staging")]
+
+
+def test_a_folder_where_a_result_file_goes_is_refused(tmp_path: Path) -> None:
+    """A user's folder named like a result file: refused naming it, nothing moved or hidden."""
+    (tmp_path / "out" / "a.txt").mkdir(parents=True)
+    (tmp_path / "out" / "a.txt" / "inner.dat").write_text("user")
+    with pytest.raises(InputError, match=r"out/a.txt: cannot write the output file: a folder of that name exists"):
+        with ResultsDirectory(tmp_path / "out").task("t") as stage:
+            (stage / "a.txt").write_text("result")
+            (stage / "b.txt").write_text("result")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.txt"]
+    assert (tmp_path / "out" / "a.txt" / "inner.dat").read_text() == "user"
+
+
+def test_a_file_where_a_result_folder_goes_is_named(tmp_path: Path) -> None:
+    """``b`` is a file where the results need a folder ``b/``: the error names ``b/c.txt``, not
+    the file moved before it; the earlier move is undone."""
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "b").write_text("user")
+    with pytest.raises(InputError, match=r"out/b/c.txt: cannot write the output file: Not a directory"):
+        with ResultsDirectory(tmp_path / "out").task("t") as stage:
+            (stage / "a.txt").write_text("result")
+            (stage / "b").mkdir()
+            (stage / "b" / "c.txt").write_text("result")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["b"]

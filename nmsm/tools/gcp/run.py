@@ -8,8 +8,9 @@ tasks in index order, each starting from the previous solution; write the result
 (:mod:`nmsm.tools.gcp.outputs`) through a staged results folder and copy the settings file
 there. A stop (Ctrl-C) during task k+1 writes the results after task k, as the run would,
 into ``<results>/stopped_after_task_<k>/`` (with ``feet="separately"``: only when every
-group has a finished task), nothing at the top of the results folder; a later run retires
-that folder into ``superseded/``.
+group has a finished task; the earlier groups' results are after all their tasks) and
+nothing else: an earlier complete run's files stay at the top; the next run retires the
+folder into ``superseded/`` with them.
 
 Options:
 
@@ -39,7 +40,7 @@ from typing import Any
 import attrs
 
 from nmsm.core.problem import Solution
-from nmsm.core.results import ResultsDirectory
+from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import build_terms
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, read_osimx
@@ -215,31 +216,27 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
         finished = groups + latest
         if keep_finished_on_stop and len(finished) == len(groups_inputs):  # every foot has a finished task
             k = len(finished[-1].solutions)
-            folder = STOPPED_FOLDER.format(k=k)
-            _write(results, folder, settings, finished, casadi_model, motion, grf, osimx, update_motion,
-                   note=f"stopped during task {k + 1} of {len(settings.tasks)}: results after task {k}")
-            print(f"nmsm: GCP stopped during task {k + 1}; the results after task {k} are in "
-                  f"{results.path / folder}", file=sys.stderr)
+            where = f" of foot group {len(finished)}" if len(groups_inputs) > 1 else ""
+            _write(results, settings, finished, casadi_model, motion, grf, osimx, update_motion, stopped_after=k,
+                   note=f"stopped during task {k + 1} of {len(settings.tasks)}{where}: results after task {k}"
+                        + (" (earlier groups: all tasks)" if where else ""))
+            print(f"nmsm: GCP stopped during task {k + 1}{where}; the results after task {k} are in "
+                  f"{results.path / STOPPED_FOLDER.format(k=k)}", file=sys.stderr)
         raise
-    errors = _write(results, "", settings, groups, casadi_model, motion, grf, osimx, update_motion)
+    errors = _write(results, settings, groups, casadi_model, motion, grf, osimx, update_motion)
     results.copy_in(path)
     return GcpRunResult(settings, groups, results.path, errors, time.perf_counter() - start)
 
 
-#: subfolder of the results folder for the tasks finished before a stop (``{k}``: last one)
-STOPPED_FOLDER = "stopped_after_task_{k}"
-
-
-def _write(results: ResultsDirectory, folder: str, settings: GroundContactPersonalizationSettings,
-           groups: list[GroupResult], casadi_model: CasadiModel, motion: Any, grf: Any, osimx: OsimxModel | None,
-           update_motion: bool, note: str | None = None) -> dict[int, dict[str, float]]:
-    """Write the groups' results (into ``folder`` of the results folder if given) as one
-    task; returns the error table."""
+def _write(results: ResultsDirectory, settings: GroundContactPersonalizationSettings, groups: list[GroupResult],
+           casadi_model: CasadiModel, motion: Any, grf: Any, osimx: OsimxModel | None, update_motion: bool, *,
+           stopped_after: int | None = None, note: str | None = None) -> dict[int, dict[str, float]]:
+    """Write the groups' results as one task (``stopped_after``: a stopped run's results
+    after that task, :meth:`ResultsDirectory.stopped_task`); returns the error table."""
     errors = {foot.index: report.rms_errors(foot, values)
               for group in groups for foot, values in zip(group.feet, group.values)}
-    with results.task("gcp") as staging:
-        stage = staging / folder
-        stage.mkdir(parents=True, exist_ok=True)
+    task = results.task("gcp") if stopped_after is None else results.stopped_task(stopped_after)
+    with task as stage:
         write_results(stage, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
         (stage / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors, note), encoding="utf-8")
     return errors

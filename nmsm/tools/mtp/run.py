@@ -10,8 +10,9 @@ Steps (the original's ``MuscleTendonPersonalizationTool``):
 4. results written per §4.6 (:mod:`nmsm.tools.mtp.outputs`), staged, plus the settings file.
 
 A stop (Ctrl-C) during task k+1 writes the results after task k, as step 4 would, into
-``<results>/stopped_after_task_<k>/`` (``mtpSummary.txt`` says so), and nothing at the top of
-the results folder; a later run retires that folder into ``superseded/`` with its own files.
+``<results>/stopped_after_task_<k>/`` (``mtpSummary.txt`` says so) and nothing else: an
+earlier complete run's files stay at the top; the next run retires the folder into
+``superseded/`` with them.
 
 ``options``: ``results_directory`` (write elsewhere than the settings say),
 ``print_level`` (IPOPT, default 0), ``max_iterations`` (override), ``tolerance`` (IPOPT
@@ -33,7 +34,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from nmsm.core.results import ResultsDirectory
+from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import CostTerm, build_terms
 from nmsm.errors import InputError, SolverError
 from nmsm.io.layout import trial_table_folders
@@ -269,15 +270,15 @@ def output_osimx_name(setup: MtpSetup) -> str:
     return f"{base}_mtp.osimx"
 
 
-def write_results(outcome: MtpOutcome, results: ResultsDirectory, folder: str = "",
+def write_results(outcome: MtpOutcome, results: ResultsDirectory, *, stopped_after: int | None = None,
                   note: str | None = None) -> None:
-    """Write ``outcome`` into ``results`` (into its subfolder ``folder`` if given) as one
-    task; ``note``: a first line of ``mtpSummary.txt``."""
+    """Write ``outcome`` into ``results`` as one task (``stopped_after``: a stopped run's
+    results after that task, :meth:`ResultsDirectory.stopped_task`); ``note``: a first line
+    of ``mtpSummary.txt``."""
     setup = outcome.setup
     trial_times = [t.time for t in outcome.data.trials]
-    with results.task("mtp_results") as staging:
-        stage = staging / folder
-        stage.mkdir(parents=True, exist_ok=True)
+    task = results.task("mtp_results") if stopped_after is None else results.stopped_task(stopped_after)
+    with task as stage:
         outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)
         outputs.parameter_file(stage, outcome.state, outcome.final_muscles, setup.model_muscles)
         if setup.passive_trials:
@@ -349,16 +350,14 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
     return outcome
 
 
-#: subfolder of the results folder for the tasks finished before a stop (``{k}``: last one)
-STOPPED_FOLDER = "stopped_after_task_{k}"
-
 
 def _keep_finished_tasks(setup: MtpSetup, start_data: MtpData, mtli: MtliResult | None,
                          finished: Sequence[tuple[MtpData, MtpState, TaskOutcome]], results: ResultsDirectory,
                          start: float) -> None:
     """A stop (Ctrl-C) during task k+1: write the results after task k (as the tool would
     after its last task) into ``<results>/stopped_after_task_<k>/``, so finished tasks are
-    not lost; nothing when no task finished. Recorded with the run, so a rerun retires it."""
+    not lost; nothing when no task finished. An earlier complete run's files stay in place;
+    the next run retires the folder (:meth:`ResultsDirectory.stopped_task`)."""
     if not finished:
         return
     data, state, _ = finished[-1]
@@ -368,8 +367,7 @@ def _keep_finished_tasks(setup: MtpSetup, start_data: MtpData, mtli: MtliResult 
     outcome = MtpOutcome(setup, start_data, data, state, mtli, tasks, plain, synx, results.path,
                          time.perf_counter() - start)
     k = len(finished)
-    folder = STOPPED_FOLDER.format(k=k)
-    write_results(outcome, results, folder,
+    write_results(outcome, results, stopped_after=k,
                   note=f"stopped during task {k + 1} of {len(setup.tasks)}: results after task {k}")
-    print(f"nmsm: MTP stopped during task {k + 1}; the results after task {k} are in {results.path / folder}",
-          file=sys.stderr)
+    print(f"nmsm: MTP stopped during task {k + 1}; the results after task {k} are in "
+          f"{results.path / STOPPED_FOLDER.format(k=k)}", file=sys.stderr)

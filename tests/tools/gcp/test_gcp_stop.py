@@ -40,21 +40,27 @@ def _run(settings: Path, out: Path, **options) -> None:
 def test_stop_during_the_third_task_keeps_the_second(shared_data: Path, tmp_path: Path,
                                                      monkeypatch: pytest.MonkeyPatch,
                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Run A finishes; rerun B is stopped in task 3: its results after task 2 go into
+    ``stopped_after_task_2/`` and A's files stay at the top, unchanged; run C retires both."""
     settings, out = shared_data / SETTINGS, tmp_path / "gcp"
+    _run(settings, out)  # A
+    complete = _files(out)
+    a_osimx = (out / "bodyModel_gcp.osimx").read_bytes()
     _stop_in_call(monkeypatch, 3)
     with pytest.raises(KeyboardInterrupt):
-        _run(settings, out)
+        _run(settings, out)  # B
     assert "the results after task 2 are in" in capsys.readouterr().err
     kept = out / "stopped_after_task_2"
-    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [kept.name]
+    assert (out / "bodyModel_gcp.osimx").read_bytes() == a_osimx and not (out / "superseded").exists()
     log = (kept / "commandWindowOutput.txt").read_text().splitlines()
     assert log[1] == "stopped during task 3 of 3: results after task 2"
     assert [line.split(" (")[0] for line in log if line.startswith("task ")] == ["task 1", "task 2"]
-    stopped = _files(kept)
+    assert _files(kept) == [f for f in complete if f != settings.name]  # what a finished run writes
     monkeypatch.undo()
-    _run(settings, out)  # to the end: the stopped run's folder is retired with it
+    _run(settings, out)  # C
     assert not kept.exists() and (out / "superseded" / kept.name / "commandWindowOutput.txt").is_file()
-    assert stopped == [f for f in _files(out) if f != settings.name]  # what a finished run writes
+    assert (out / "superseded" / "bodyModel_gcp.osimx").read_bytes() == a_osimx
+    assert _files(out) == complete
 
 
 @pytest.mark.parametrize("options", [{}, {"keep_finished_on_stop": False}])

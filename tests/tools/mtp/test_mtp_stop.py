@@ -31,8 +31,17 @@ def _two_task_settings(shared_data: Path, tmp_path: Path) -> Path:
 def test_stop_during_the_second_task_keeps_the_first(shared_data: Path, tmp_path: Path,
                                                      monkeypatch: pytest.MonkeyPatch,
                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Run A finishes; rerun B is stopped in task 2: B's results after task 1 go into
+    ``stopped_after_task_1/`` and A's files stay at the top, unchanged; run C (to the end)
+    retires both into ``superseded/``."""
     settings = _two_task_settings(shared_data, tmp_path)
     out = tmp_path / "results"
+    osimx = "UF_Subject_3_reduced_muscles_mtp.osimx"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mtp_run.run_settings(settings, results_directory=out)  # A
+    complete = _files(out)
+    a_osimx = (out / osimx).read_bytes()
     real = mtp_run.solve_task_problem
     calls = []
 
@@ -46,26 +55,28 @@ def test_stop_during_the_second_task_keeps_the_first(shared_data: Path, tmp_path
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         with pytest.raises(KeyboardInterrupt):
-            mtp_run.run_settings(settings, results_directory=out)
+            mtp_run.run_settings(settings, results_directory=out)  # B
     kept = out / "stopped_after_task_1"
     assert "results after task 1 are in" in capsys.readouterr().err
-    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["stopped_after_task_1"]
+    assert (out / osimx).read_bytes() == a_osimx and not (out / "superseded").exists()  # A untouched
     summary = (kept / "mtpSummary.txt").read_text().splitlines()
     assert summary[0] == "stopped during task 2 of 2: results after task 1"
     assert summary[1].startswith("task 1: Solve_Succeeded")
-    assert (kept / "UF_Subject_3_reduced_muscles_mtp.osimx").is_file()
-    kept_files = sorted(p.relative_to(kept).as_posix() for p in kept.rglob("*") if p.is_file())
-    # the run to the end retires the stopped run's files (they are recorded with it)
+    stopped = sorted(p.relative_to(kept).as_posix() for p in kept.rglob("*") if p.is_file())
+    assert stopped == [f for f in complete if f != settings.name and not f.startswith("stopped_after")]
     monkeypatch.setattr(mtp_run, "solve_task_problem", real)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        mtp_run.run_settings(settings, results_directory=out)
+        mtp_run.run_settings(settings, results_directory=out)  # C
     assert not kept.exists()
     assert (out / "superseded" / "stopped_after_task_1" / "mtpSummary.txt").is_file()
-    assert (out / "UF_Subject_3_reduced_muscles_mtp.osimx").is_file()
-    finished = sorted(p.relative_to(out).as_posix() for p in out.rglob("*")
-                      if p.is_file() and not p.name.startswith(".") and p.relative_to(out).parts[0] != "superseded")
-    assert kept_files == [f for f in finished if f != settings.name]  # what a finished run writes
+    assert (out / "superseded" / osimx).read_bytes() == a_osimx
+    assert _files(out) == complete
+
+
+def _files(folder: Path) -> list[str]:
+    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*")
+                  if p.is_file() and not p.name.startswith(".") and p.relative_to(folder).parts[0] != "superseded")
 
 
 def test_stop_during_the_first_task_writes_nothing(shared_data: Path, tmp_path: Path,
