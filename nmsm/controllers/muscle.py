@@ -158,7 +158,8 @@ class MuscleActivationController(Controller):
                 degree=int(setting(settings, "surrogate_model_polynomial_degree", 5)),
                 epsilon=float(setting(settings, "epsilon", 1e-4)),
                 load=bool(setting(settings, "load_surrogate_model", False)),
-                save=bool(setting(settings, "save_surrogate_model", False)), settings_file=setup.settings_file,
+                save=bool(setting(settings, "save_surrogate_model", False)) and setup.save_files,
+                settings_file=setup.settings_file,
                 file_name=str(setting(settings, "surrogate_model_file_name", "surrogateMuscles.mat")))
         muscles = muscles or surrogate.muscle_names
         osimx = None

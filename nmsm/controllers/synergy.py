@@ -111,7 +111,8 @@ class SynergyController(Controller):
         surrogate = load_surrogate(
             setup.model_file, data_dir, coordinates, degree=int(setting(settings, "surrogate_model_polynomial_degree", 5)),
             epsilon=float(setting(settings, "epsilon", 1e-4)), load=bool(setting(settings, "load_surrogate_model", False)),
-            save=bool(setting(settings, "save_surrogate_model", False)), settings_file=setup.settings_file,
+            save=bool(setting(settings, "save_surrogate_model", False)) and setup.save_files,
+                settings_file=setup.settings_file,
             file_name=str(setting(settings, "surrogate_model_file_name", "surrogateMuscles.mat")))
         self.muscle_model = MuscleModel.build(
             self.muscles, coordinates, surrogate, self.osim_model, self.osimx,

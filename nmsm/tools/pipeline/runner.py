@@ -205,8 +205,7 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     check_inputs(spec, {s.name: s.load_settings() for s in enabled})
     selected = _selection(spec, only, until)
     errors: list[tuple[str, InputError]] = []  # check_only: (stage, error), every stage's
-    checked = validate_stages(spec, selected, quiet=not check_only, every_error=check_only,
-                              errors=errors if check_only else None)
+    checked = validate_stages(spec, selected, quiet=not check_only, errors=errors if check_only else None)
     if check_only:
         say(f"settings checked: {', '.join(checked) or 'no stage selected'}")
     state = PipelineState.load(results, salvage=rebuild)
@@ -318,12 +317,13 @@ def _bind_terms(stage: StageSpec, settings: StageSettings, wired: dict[str, str]
         return None
     try:
         bind_stage(stage, settings)
-    except NmsmError as exc:
+    except Exception as exc:  # noqa: BLE001 - every problem of binding is reported with the others
         if isinstance(exc, InputError):
             return InputError(f"stage '{stage.name}' ({kind.code}), binding its terms to its model and data: "
                               f"{exc.detail}", file=exc.file, line=exc.line, element=exc.element,
                               expected=exc.expected)
-        return InputError(f"stage '{stage.name}' ({kind.code}), binding its terms to its model and data: {exc}",
+        what = str(exc) if isinstance(exc, NmsmError) else f"{type(exc).__name__}: {exc}"
+        return InputError(f"stage '{stage.name}' ({kind.code}), binding its terms to its model and data: {what}",
                           file=stage.settings_file or stage.file)
     say(f"      terms of stage '{stage.name}' bound to its model and data")
     return None
@@ -334,17 +334,17 @@ def _raise_all(errors: Sequence[InputError]) -> None:
     if len(errors) == 1:
         raise errors[0]
     if errors:
-        raise InputError(f"the settings of {len(errors)} stages have errors:\n  " + "\n  ".join(map(str, errors)))
+        raise InputError(f"{len(errors)} errors in the pipeline's stages:\n  " + "\n  ".join(map(str, errors)))
 
 
-def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = True, every_error: bool = False,
+def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = True,
                     errors: list[tuple[str, InputError]] | None = None) -> list[str]:
     """Validate the settings of every enabled stage in ``selected`` as the runner will hand
     them to the tool (:mod:`nmsm.tools.pipeline.validation`), earlier stages' outputs wired
-    as stand-ins; :class:`InputError` at the user's settings file and line (``every_error``:
-    one error listing every stage's first error, when several stages have one; ``errors``:
-    append ``(stage, error)`` there instead of raising). Returns the names of the stages
-    checked. Nothing is read from or written into the results tree."""
+    as stand-ins; :class:`InputError` at the user's settings file and line of the first
+    stage with an error (``errors``: append every stage's ``(stage, error)`` there instead of
+    raising). Returns the names of the stages checked. Nothing is read from or written into
+    the results tree."""
     results = spec.results_directory
     artifacts = Artifacts()
     for name, path in spec.inputs.items():
@@ -359,14 +359,12 @@ def validate_stages(spec: PipelineSpec, selected: set[str], *, quiet: bool = Tru
             try:
                 validate_stage(stage, settings, quiet=quiet)
             except InputError as exc:
-                if not every_error and errors is None:
+                if errors is None:
                     raise
                 found.append((stage.name, exc))
             checked.append(stage.name)
         for artifact in stage.kind.produces:
             artifacts.provide(artifact, _stand_in(results, stage, artifact), f"stage '{stage.name}'")
-    if errors is None:
-        _raise_all([exc for _, exc in found])
     return checked
 
 

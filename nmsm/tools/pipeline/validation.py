@@ -24,7 +24,7 @@ stage's model and data as the tool checks it before solving (a coordinate, load,
 control or marker the model or controllers lack; a plugin term's own ``bind``), without
 solving and without OpenSim. For TO, VO and DO (:func:`bind_treatment`) that is the tool's
 own :func:`~nmsm.tools.treatment.tool.prepare`: model, data files, controllers, then every
-term bound while the problem is assembled (1-3 s a stage). A stage whose model or data an
+term bound while the problem is assembled (0.2-3 s a stage on the kicking tutorials). A stage whose model or data an
 earlier stage of the run makes is bound when it runs (the runner says so); JMP, MTP, NCP and
 GCP bind their terms to the problem they build from their data (MTP after its length
 initialization), so their terms are bound when they run too.
@@ -143,4 +143,4 @@ def bind_treatment(settings: Any) -> None:
         from nmsm.tools.treatment.design import design_extras
 
         declare_extra = design_extras(settings)
-    prepare(settings, solver, TreatmentOptions(parallel=1), declare_extra=declare_extra)
+    prepare(settings, solver, TreatmentOptions(parallel=1, write_results=False), declare_extra=declare_extra)

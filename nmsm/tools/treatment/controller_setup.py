@@ -48,6 +48,9 @@ class ControllerSetup:
     trial_name: str = ""
     guess: Mapping[str, ReferenceSplines] | None = None
     guess_times: np.ndarray | None = None
+    #: controllers may write files (a fitted surrogate the settings ask to save); False when
+    #: nothing is to be written (``write_results=False``, ``nmsm pipeline --check``)
+    save_files: bool = True
     extras: dict[str, Any] = attrs.field(factory=dict)
 
     def starting_splines(self) -> Mapping[str, ReferenceSplines]:

@@ -265,7 +265,7 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
         tool=tool, model=model, collocation_times=mesh.times("collocation") * t_ref, reference_duration=t_ref,
         references=refs, initial_guess=_initial_guess_splines(files), settings_file=settings.settings_file,
         model_file=Path(settings.input_model_file), trial_name=settings.trial_name,
-        osimx=getattr(settings, "input_osimx_file", None), synergy_weights=None,
+        osimx=getattr(settings, "input_osimx_file", None), synergy_weights=None, save_files=options.write_results,
     )
     setup.guess = _initial_guess_splines(guess_files)
     setup.guess_times = mesh.times("collocation") * t_guess

@@ -357,7 +357,7 @@ def test_check_validates_settings_and_shows_the_run_s_wiring(case: Path) -> None
     with pytest.raises(InputError) as info:
         run_pipeline_file(pipeline, check_only=True, log=None)
     assert str(info.value).splitlines() == [
-        "the settings of 2 stages have errors:",
+        "2 errors in the pipeline's stages:",
         f"  {case / 'maker.xml'}:5: <offset>: 'x' is not a number (expected a number)",
         f"  {pipeline}:3: <degree>: 'a' is not an integer (expected an integer)"]
     with pytest.raises(InputError, match="maker.xml:5: <offset>"):

@@ -140,7 +140,7 @@ def test_check_binds_the_terms_to_the_model(kick: Path, capsys: pytest.CaptureFi
     do.write_text(do.read_text().replace(*TYPO))
     assert main(["pipeline", "--check", str(pipeline)]) == 1
     err = capsys.readouterr().err
-    assert "the settings of 2 stages have errors" in err
+    assert "2 errors in the pipeline's stages" in err
     assert f"{to}:{line}: <coordinate_list>: stage 'to'" in err and "'knee_angel_r'" in err
     assert f"{do}:{_type_line(do)}: <type>: unknown cost 'controler_tracking'" in err
     # fixed: the terms bind, and the check passes
@@ -149,3 +149,47 @@ def test_check_binds_the_terms_to_the_model(kick: Path, capsys: pytest.CaptureFi
     assert main(["pipeline", "--check", str(pipeline)]) == 0
     assert "terms of stage 'to' bound to its model and data" in capsys.readouterr().out
     assert not (kick / "results").exists()
+
+
+def test_check_writes_nothing_even_where_the_settings_save_a_surrogate(shared_data: Path, tmp_path: Path,
+                                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """--check binds a synergy TO whose settings save the fitted surrogate: the surrogate is
+    fitted to bind the terms but not saved (it was written next to the stage's settings)."""
+    folder = tmp_path / "synergy"
+    shutil.copytree(shared_data / "treatment" / "synergy_kick_tutorial", folder)
+    for path in [folder, *folder.rglob("*")]:
+        path.chmod(path.stat().st_mode | 0o200)
+    settings = folder / "CompletedSettingsFiles" / "SynergyTOSettingsV1.xml"
+    text = settings.read_text()
+    assert "<save_surrogate_model>false</save_surrogate_model>" in text
+    (folder / "CompletedSettingsFiles" / "TO.xml").write_text(
+        text.replace("<save_surrogate_model>false</save_surrogate_model>", "<save_surrogate_model>true</save_surrogate_model>")
+        .replace("<load_surrogate_model>true</load_surrogate_model>", "<load_surrogate_model>false</load_surrogate_model>"))
+    (folder / "pipeline.xml").write_text(PIPELINE.replace('<Stage name="to"><settings_file>TO.xml</settings_file>',
+                                                  '<Stage name="to"><settings_file>CompletedSettingsFiles/TO.xml'
+                                                  '</settings_file><keep_settings_inputs>initial_guess_directory '
+                                                  'tracked_quantities_directory</keep_settings_inputs>')
+                                         .replace('      <Stage name="vo"><settings_file>VO.xml</settings_file></Stage>\n', "")
+                                         .replace('      <Stage name="do"><settings_file>DO.xml</settings_file></Stage>\n', ""))
+    before = _tree(folder)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["pipeline", "--check", str(folder / "pipeline.xml")]) == 0
+    assert "terms of stage 'to' bound to its model and data" in capsys.readouterr().out
+    assert _tree(folder) == before
+
+
+def test_check_reports_an_unexpected_binding_error_with_the_others(kick: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """An exception other than nmsm's own while binding (e.g. bad data reaching numpy) is
+    listed as the stage's error with its type, not a traceback."""
+    import nmsm.tools.pipeline.validation as validation
+
+    def broken(settings):
+        raise ValueError("operands could not be broadcast together")
+
+    monkeypatch.setattr(validation, "bind_treatment", broken)
+    assert main(["pipeline", "--check", str(kick / "pipeline.xml")]) == 1
+    err = capsys.readouterr().err
+    assert "stage 'to' (to), binding its terms to its model and data: ValueError: operands could not" in err
+    assert "Traceback" not in err
