@@ -159,11 +159,12 @@ def check_request(request: PreprocessRequest) -> list[str]:
 
 @contextmanager
 def _named(request: PreprocessRequest) -> Iterator[None]:
-    """Errors without a file name the request's settings file and the element for the option."""
+    """Errors without a file, or about the output folder (whose messages name it), name the
+    request's settings file and the element for the option."""
     try:
         yield
     except InputError as exc:
-        if request.settings_file is not None and exc.file is None:
+        if request.settings_file is not None and (exc.file is None or exc.element == "--output"):
             exc.file = str(request.settings_file)
             exc.element = request.elements.get(exc.element or "", exc.element)
             exc.args = (exc._compose(),)
@@ -174,7 +175,7 @@ def run_checked(requests: PreprocessRequest | Sequence[PreprocessRequest], *,
                 keep_intermediate: bool = True) -> list[str]:
     """Check every request (:func:`check_request`), then process them staged into their
     common output folder (module docstring); returns the trial names. ``keep_intermediate``:
-    keep ``intermediate/`` (with several requests, one subfolder per request's prefix)."""
+    keep ``intermediate/`` (with several requests, one subfolder named after each request's first trial)."""
     requests = [requests] if isinstance(requests, PreprocessRequest) else list(requests)
     if not requests:
         raise ValueError("no preprocessing request")

@@ -68,8 +68,8 @@ def refuse_earlier_trials(output: Path, names: Collection[str], written: Collect
     if not stale:
         return
     shown = ", ".join(stale[:8]) + (f" and {len(stale) - 8} more" if len(stale) > 8 else "")
-    raise InputError(f"the output folder already holds files of trial(s) {', '.join(sorted(names))} that this run "
-                     f"would not rewrite: {shown}; the tools would combine them with this run's files (another run, "
+    raise InputError(f"the output folder {output} already holds files of trial(s) {', '.join(sorted(names))} that "
+                     f"this run would not rewrite: {shown}; the tools would combine them with this run's files (another run, "
                      "maybe another time window)", file=output, element="--output",
                      expected="a new output folder, or one without those files (move or remove them first)")
 

@@ -165,7 +165,7 @@ def test_earlier_files_of_the_trial_are_refused(inputs, model, tmp_path):
     with pytest.raises(InputError) as info:
         main(_args(inputs, out, "0.5 1.6", emg=True, ik=True))
     message = str(info.value)
-    assert message.startswith(f"{out}: --output: the output folder already holds files of trial(s) walk_1 that this "
+    assert message.startswith(f"{out}: --output: the output folder {out} already holds files of trial(s) walk_1 that this "
                               "run would not rewrite: GRFData/walk_1.sto, IDData/walk_1.sto, MAData/walk_1/")
     assert "IKData/walk_1.sto" not in message and "EMGData" not in message
     assert _snapshot(out) == before

@@ -139,3 +139,19 @@ def test_pipeline_stage_checks_first(analysis: Path, tmp_path: Path) -> None:
     with pytest.warns(UserWarning, match=rf"{ik}: read with inDegrees=no, rotational column\(s\) 'knee_angle_r'"):
         run_pipeline_file(pipeline, log=None)
     assert sorted(p.name for p in (tmp_path / "results" / "pre" / "IKData").iterdir()) == ["gait_1.sto", "gait_2.sto"]
+
+
+def test_settings_file_names_its_element_for_earlier_trial_files(analysis: Path, tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """A second ``nmsm run`` of the settings without the EMG would leave the first run's EMG
+    of the same trials: refused at the settings file's ``<results_directory>`` (was the
+    option ``--output``), the folder named in the message."""
+    settings = _stage_settings(tmp_path)
+    assert main(["run", str(settings)]) == 0
+    (analysis / "EMGData" / "gait.sto").unlink()
+    capsys.readouterr()
+    assert main(["run", str(settings)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"nmsm: error: {settings}: <results_directory>: the output folder {tmp_path / 'out'} "
+                          "already holds files of trial(s) gait_1 that this run would not rewrite: "
+                          "EMGData/gait_1.sto"), err
