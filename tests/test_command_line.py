@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 from nmsm import __version__
 from nmsm.cli import build_parser
@@ -23,7 +24,8 @@ def test_progress_interval_option():
 
 
 def test_run_says_where_the_results_went(shared_data, tmp_path, capsys):
-    """``nmsm run`` ends with the results folder for every tool (MTP printed nothing at all)."""
+    """``nmsm run`` ends with the results folder (MTP printed nothing at all on success; every
+    runner's return value has the folder: the next test)."""
     import warnings
 
     from nmsm.cli import main
@@ -33,3 +35,23 @@ def test_run_says_where_the_results_went(shared_data, tmp_path, capsys):
         warnings.simplefilter("ignore")
         assert main(["--progress", "0", "run", str(settings), "-o", str(tmp_path / "mtp")]) == 0
     assert capsys.readouterr().out.splitlines()[-1] == f"nmsm: results in {tmp_path / 'mtp'}"
+
+
+def test_every_runner_of_nmsm_run_says_where_its_results_are():
+    """What each ``nmsm run`` runner returns gives the line above: a results folder field, or
+    the folder itself (the pipeline's preprocessing and surrogate stages)."""
+    import importlib
+    import inspect
+    import typing
+
+    import attrs
+
+    from nmsm.tools.dispatch import TOOL_RUNNERS
+
+    for tag, target in TOOL_RUNNERS.items():
+        module, name = target.split(":")
+        runner = getattr(importlib.import_module(module), name)
+        returned = typing.get_type_hints(runner)["return"]
+        if returned is not Path:
+            assert inspect.isclass(returned) and attrs.has(returned), tag
+            assert "results_directory" in attrs.fields_dict(returned), tag

@@ -27,6 +27,16 @@ if TYPE_CHECKING:
     from nmsm.io.settings.document import SettingsDocument
 
 CONTROLLER = "RCNLSynergyController"
+#: the original's default ``<surrogate_model_file_name>``
+DEFAULT_FILE_NAME = "surrogateMuscles.mat"
+
+
+def surrogate_model_path(settings_file: str | os.PathLike[str] | None, file_name: str = DEFAULT_FILE_NAME) -> Path:
+    """Where a ``<surrogate_model_file_name>`` is kept: next to the settings file (the current
+    folder without one), as JSON (the name's extension replaced by ``.json``; Windows
+    separators accepted)."""
+    base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
+    return (base / Path(file_name.replace("\\", "/")).with_suffix(".json")).resolve()
 
 
 @attrs.frozen
@@ -66,8 +76,7 @@ def surrogate_settings_from_document(doc: SettingsDocument) -> SurrogateSettings
     if doc.boolean(controller, "perform_latin_hypercube_sampling", False):
         warnings.warn(f"{doc.path}: <perform_latin_hypercube_sampling> is ignored (unused by the original's "
                       "treatment tools); sample with `nmsm surrogate --motion ...` instead", stacklevel=2)
-    name = doc.text(controller, "surrogate_model_file_name", "surrogateMuscles.mat")
-    model_path = (Path(doc.path).resolve().parent / Path(name.replace("\\", "/")).with_suffix(".json")).resolve()
+    model_path = surrogate_model_path(doc.path, doc.text(controller, "surrogate_model_file_name", DEFAULT_FILE_NAME))
     return SurrogateSettings(
         model_file=Path(model_file),
         data_directory=Path(data),

@@ -46,16 +46,15 @@ def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLi
     fits are cached per process (same data, coordinates, degree and epsilon). ``file_name``:
     the settings' ``<surrogate_model_file_name>``, kept as JSON next to the settings file
     (extension replaced by ``.json``, :mod:`nmsm.tools.surrogate.settings`)."""
-    from nmsm.tools.surrogate.settings import SurrogateSettings
+    from nmsm.tools.surrogate.settings import SurrogateSettings, surrogate_model_path
     from nmsm.tools.surrogate.tool import surrogate_from_settings
 
     key = (str(Path(model_file).resolve()), str(Path(data_directory).resolve()), tuple(coordinates), degree, epsilon)
     if key in _SURROGATE_CACHE and not (load or save):
         return _SURROGATE_CACHE[key]
-    base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
     settings = SurrogateSettings(model_file=Path(model_file), data_directory=Path(data_directory),
                                  coordinates=tuple(coordinates), epsilon=epsilon, degree=degree, load=load, save=save,
-                                 model_path=base / Path(file_name.replace("\\", "/")).with_suffix(".json"),
+                                 model_path=surrogate_model_path(settings_file, file_name),
                                  settings_file=Path(settings_file) if settings_file else None)
     model = surrogate_from_settings(settings)
     _SURROGATE_CACHE[key] = model
