@@ -20,10 +20,9 @@ Per full-length trial ``<name>`` and each time window ``k`` (output trial ``<nam
 Rotational IK columns are written in degrees (``inDegrees=yes``) as the input was; the IK
 header is checked against the model's rotational coordinates (a wrong ``inDegrees`` warns).
 
-Each time window of a full-length trial becomes a
-:class:`~nmsm.tools.preprocess.run.PreprocessRequest` (so each window keeps its own EMG
-padding), and
-all of them go through ``nmsm preprocess``'s checked path
+Each full-length trial becomes one :class:`~nmsm.tools.preprocess.run.PreprocessRequest`
+(its files read and its EMG processed once; each time window keeps its own EMG padding,
+``emg_padding_per_window``), and all of them go through ``nmsm preprocess``'s checked path
 (:func:`nmsm.tools.preprocess.command.run_checked`): every trial's files are read and
 checked (each covers the trial's time ranges, the output folder holds no input, no earlier
 run's files of the trials) before anything is processed, then the trials are written staged,
@@ -68,9 +67,9 @@ def _elements(trial: PreprocessTrial) -> dict[str, str]:
 
 
 def requests(settings: DataPreprocessingSettings, settings_file: Path) -> list[PreprocessRequest]:
-    """One checked-path request per time window of each full-length trial (module docstring);
-    :class:`InputError`
-    for a trial with neither an IK nor an ID file."""
+    """One checked-path request per full-length trial, each time window with its own EMG
+    padding (module docstring); :class:`InputError` for a trial with neither an IK nor an ID
+    file."""
     source = settings.motion_data_directory
     out: list[PreprocessRequest] = []
     for trial in settings.trials:
@@ -83,18 +82,16 @@ def requests(settings: DataPreprocessingSettings, settings_file: Path) -> list[P
                              element=f"<Trial name=\"{trial.name}\">",
                              expected=f"{source}/IKData/{trial.name}.sto")
         ma = source / "MAData" / trial.name
-        pairs = trial.time_ranges
-        for k in range(0, len(pairs), 2):  # one request a window: each window's own EMG padding
-            out.append(PreprocessRequest(
-                time_pairs=((pairs[k], pairs[k + 1]),), output=settings.results_directory,
-                model=settings.input_model_file, prefix=trial.name, names=(f"{trial.name}_{k // 2 + 1}",),
-                rows=settings.rows_per_trial, cutoff=settings.cutoff_frequency, raw_emg=found("EMGData"),
-                emg=EmgOptions(settings.filter_order, settings.emg_high_pass_frequency,
-                               settings.emg_low_pass_frequency, demean=settings.emg_demean),
-                emg_padding_time=settings.emg_padding_time, ik=found("IKData"), inverse_dynamics=found("IDData"),
-                grf=found("GRFData"), muscle_analysis=ma if ma.is_dir() else None,
-                filter_order=settings.filter_order, ik_radians=False, clip_emg=True, settings_file=settings_file,
-                elements=_elements(trial)))
+        pairs = tuple((trial.time_ranges[k], trial.time_ranges[k + 1]) for k in range(0, len(trial.time_ranges), 2))
+        out.append(PreprocessRequest(
+            time_pairs=pairs, output=settings.results_directory, model=settings.input_model_file, prefix=trial.name,
+            rows=settings.rows_per_trial, cutoff=settings.cutoff_frequency, raw_emg=found("EMGData"),
+            emg=EmgOptions(settings.filter_order, settings.emg_high_pass_frequency,
+                           settings.emg_low_pass_frequency, demean=settings.emg_demean),
+            emg_padding_time=settings.emg_padding_time, emg_padding_per_window=True, ik=found("IKData"),
+            inverse_dynamics=found("IDData"), grf=found("GRFData"), muscle_analysis=ma if ma.is_dir() else None,
+            filter_order=settings.filter_order, ik_radians=False, clip_emg=True, settings_file=settings_file,
+            elements=_elements(trial)))
     return out
 
 

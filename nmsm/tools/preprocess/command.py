@@ -100,7 +100,8 @@ def check_input_times(request: PreprocessRequest) -> None:
     emg = request.raw_emg if request.raw_emg is not None else request.processed_emg
     if emg is not None:
         table = select_channels(read_table(emg), request.emg_channels)
-        check_covers(table.time, emg_windows(pairs, request.rows, request.emg_padding_time), what="EMG", file=emg)
+        check_covers(table.time, emg_windows(pairs, request.rows, request.emg_padding_time,
+                                             per_window=request.emg_padding_per_window), what="EMG", file=emg)
     if request.markers is not None:
         _check_marker_times(request)
     if request.muscle_analysis is not None:

@@ -84,6 +84,7 @@ class PreprocessRequest:
     filter_order: int = 4  #: Butterworth order of the IK, ID and muscle-analysis low-pass
     ik_radians: bool = True  #: write rotational IK in radians (False: keep the input's unit)
     clip_emg: bool = False  #: set the EMG spline's undershoots below 0 to 0
+    emg_padding_per_window: bool = False  #: each time pair its own EMG padding (else the shortest's)
     names: tuple[str, ...] = ()  #: the trials' names, one per time pair (default ``<prefix>_<k>``)
     settings_file: Path | None = None  #: settings file the request was read from (named in errors)
     #: command-line option (``--rows``) -> the settings element that gave it, for errors
@@ -190,7 +191,8 @@ def process(request: PreprocessRequest, work: Path | None = None) -> list[str]:
     return split_into_trials(request.time_pairs, sources, out, prefix=request.prefix, names=request.names or None,
                              rows=request.rows,
                              cutoff=request.cutoff, filter_order=request.filter_order,
-                             emg_padding_time=request.emg_padding_time, ik_radians=request.ik_radians,
+                             emg_padding_time=request.emg_padding_time,
+                             emg_padding_per_window=request.emg_padding_per_window, ik_radians=request.ik_radians,
                              clip_emg=request.clip_emg)
 
 

@@ -86,10 +86,19 @@ def check_time_pairs(time_pairs: Sequence[tuple[float, float]], element: str = "
 
 
 def emg_windows(time_pairs: Sequence[tuple[float, float]], rows: int = 101,
-                padding_time: float = EMG_PADDING_SECONDS) -> list[tuple[float, float]]:
-    """The EMG windows (s): each pair widened by ``pad / (rows - 1) (t1 - t0)`` each side."""
-    pad = padding_frames(time_pairs, rows, padding_time)
-    return [(t0 - pad / (rows - 1) * (t1 - t0), t1 + pad / (rows - 1) * (t1 - t0)) for t0, t1 in time_pairs]
+                padding_time: float = EMG_PADDING_SECONDS, *, per_window: bool = False) -> list[tuple[float, float]]:
+    """The EMG windows (s): each pair widened by ``pad / (rows - 1) (t1 - t0)`` each side
+    (``pad``: :func:`padding_frames` of all pairs, or of each pair alone with ``per_window``)."""
+    pads = _padding_per_pair(time_pairs, rows, padding_time, per_window)
+    return [(t0 - pad / (rows - 1) * (t1 - t0), t1 + pad / (rows - 1) * (t1 - t0))
+            for pad, (t0, t1) in zip(pads, time_pairs)]
+
+
+def _padding_per_pair(time_pairs: Sequence[tuple[float, float]], rows: int, padding_time: float,
+                      per_window: bool) -> list[int]:
+    if per_window:
+        return [padding_frames([pair], rows, padding_time) for pair in time_pairs]
+    return [padding_frames(time_pairs, rows, padding_time)] * len(time_pairs)
 
 
 def _write(path: Path, like: Table, time: np.ndarray, values: np.ndarray, *, in_degrees: bool = False,
@@ -162,10 +171,13 @@ def split_into_trials(
     cutoff: float | None = 6.0,
     filter_order: int = 4,
     emg_padding_time: float = EMG_PADDING_SECONDS,
+    emg_padding_per_window: bool = False,
     ik_radians: bool = True,
     clip_emg: bool = False,
 ) -> list[str]:
-    """Write the trials; returns their names (``names`` or ``<prefix>_<k>``)."""
+    """Write the trials; returns their names (``names`` or ``<prefix>_<k>``). The EMG padding
+    is that of the shortest pair, or each pair's own with ``emg_padding_per_window`` (the
+    pipeline's ``<DataPreprocessingTool>`` stage)."""
     check_time_pairs(time_pairs)
     out = Path(results_directory)
     names = list(names) if names is not None else [f"{prefix}_{k}" for k in range(1, len(time_pairs) + 1)]
@@ -204,8 +216,9 @@ def split_into_trials(
                 _write(out / "MAData" / name / f"{name}_{key}.sto", table, t, v)
     if sources.emg is not None:
         table = read_table(sources.emg)
-        pad = padding_frames(time_pairs, rows, emg_padding_time)
-        for name, (start, end) in zip(names, emg_windows(time_pairs, rows, emg_padding_time)):
+        pads = _padding_per_pair(time_pairs, rows, emg_padding_time, emg_padding_per_window)
+        windows = emg_windows(time_pairs, rows, emg_padding_time, per_window=emg_padding_per_window)
+        for name, pad, (start, end) in zip(names, pads, windows):
             times = np.linspace(start, end, rows + 2 * pad)
             values = resample(table, times, what="EMG")
             _write(out / "EMGData" / f"{name}.sto", table, times, np.clip(values, 0.0, None) if clip_emg else values)

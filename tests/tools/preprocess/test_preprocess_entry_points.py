@@ -153,5 +153,5 @@ def test_settings_file_names_its_element_for_earlier_trial_files(analysis: Path,
     assert main(["run", str(settings)]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"nmsm: error: {settings}: <results_directory>: the output folder {tmp_path / 'out'} "
-                          "already holds files of trial(s) gait_1 that this run would not rewrite: "
+                          "already holds files of trial(s) gait_1, gait_2 that this run would not rewrite: "
                           "EMGData/gait_1.sto"), err

@@ -9,7 +9,7 @@ import pytest
 
 from nmsm.errors import InputError
 from nmsm.io.storage import read_storage, table_from_columns, write_storage
-from nmsm.tools.preprocess.trials import TrialSources, padding_frames, split_into_trials
+from nmsm.tools.preprocess.trials import TrialSources, emg_windows, padding_frames, split_into_trials
 from nmsm.tools.preprocess.velocity import create_velocity_file, muscle_tendon_velocity
 
 
@@ -250,3 +250,13 @@ def test_velocity_made_without_touching_the_inputs(recording):
     made = read_storage(tmp / "mv" / "MAData" / "trial_1" / "trial_1_Velocity.sto")
     exact = 0.01 * 2 * np.pi * np.cos(2 * np.pi * made.time)
     assert np.abs(made.column("soleus_r") - exact).max() <= 2e-3
+
+
+def test_emg_windows_padded_per_window():
+    """``per_window``: each pair padded as if it were alone (the pipeline's stage, one request
+    per recording); by default every pair gets the shortest pair's padding frames."""
+    pairs = [(0.5, 1.6), (1.8, 2.6)]
+    alone = [emg_windows([p], 101, 0.1)[0] for p in pairs]
+    assert emg_windows(pairs, 101, 0.1, per_window=True) == alone
+    shared = emg_windows(pairs, 101, 0.1)
+    assert shared[1] == alone[1] and shared[0] != alone[0]  # the shorter pair's frames for both
