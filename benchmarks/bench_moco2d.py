@@ -11,7 +11,11 @@ translations in mm; ``referenceGRF.sto`` for the GRF, in N), with ``uptime`` bef
 machine is shared: only ratios measured together count).
 
     /tmp/dev/bin/python benchmarks/bench_moco2d.py [--modes torque muscle] [--which both]
-        [--mesh 50] [--points 2] [--tolerance 1e-4] [--work DIR] [--json FILE]
+        [--mesh 50] [--points 2] [--tolerance 1e-4] [--like-moco] [--work DIR] [--json FILE]
+
+``--like-moco``: our problem as Moco's (``write_problem(like_moco=True)``): muscle mode with
+excitations as controls and DeGrooteFregly2016 activation dynamics, activations periodic
+r<->l; control periodicity (lumbar; torque mode: joint torques r<->l).
 
 Nothing is written into the data folder; everything goes to ``--work`` (default: a new
 temporary folder). ``--json`` saves the rows; ``--table FILE...`` only prints saved rows.
@@ -46,13 +50,14 @@ def reference() -> object:
     return states_reference_table(get_bridge(), DATA)
 
 
-def run_ours(work: Path, mode: str, mesh: int, points: int, tolerance: float) -> dict:
+def run_ours(work: Path, mode: str, mesh: int, points: int, tolerance: float, like_moco: bool = False) -> dict:
     from nmsm.examples.moco2d import read_solution, tracking_error, write_problem
     from nmsm.tools.treatment.run import run_settings
 
     ref = reference()
-    problem = write_problem(work / f"nmsm_{mode}", DATA, mode, mesh_intervals=mesh, points_per_interval=points,
-                            tolerance=tolerance, reference=ref)
+    problem = write_problem(work / f"nmsm_{mode}{'_like_moco' if like_moco else ''}", DATA, mode,
+                            mesh_intervals=mesh, points_per_interval=points, tolerance=tolerance, reference=ref,
+                            like_moco=like_moco)
     load_before = uptime()
     t0 = time.perf_counter()
     with warnings.catch_warnings():
@@ -62,7 +67,7 @@ def run_ours(work: Path, mode: str, mesh: int, points: int, tolerance: float) ->
     wall = time.perf_counter() - t0
     t, q, grf = read_solution(problem.results)
     err = tracking_error(DATA, t, q, grf, ref)
-    return dict(solver="nmsm", mode=mode, wall_s=wall, solve_s=run.solution.wall_time, build_s=run.build_time,
+    return dict(solver="nmsm" + (" (like Moco)" if like_moco else ""), mode=mode, wall_s=wall, solve_s=run.solution.wall_time, build_s=run.build_time,
                 iterations=run.solution.iterations, objective=run.cost * problem.objective_factor,
                 success=bool(run.solution.success), status=run.solution.status,
                 coordinates_deg=err.coordinates_deg, translations_mm=err.translations_mm, grf_n=err.grf_n,
@@ -101,7 +106,7 @@ def table(rows: list[dict]) -> str:
     for r in rows:
         pair = by_mode[r["mode"]]
         speed = ""
-        if r["solver"] == "nmsm" and "Moco" in pair:
+        if r["solver"].startswith("nmsm") and "Moco" in pair:
             speed = f"{pair['Moco']['wall_s'] / r['wall_s']:.1f}x"
         lines.append(f"| {r['mode']} | {r['solver']} | {r['wall_s']:.1f} | {r['solve_s']:.1f} | {r['iterations']} | "
                      f"{r['objective']:.4f} | {r['status']} | {r['coordinates_deg']:.3f} | "
@@ -120,6 +125,8 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=2, help="nmsm Radau collocation points per mesh interval")
     ap.add_argument("--tolerance", type=float, default=1e-4)
     ap.add_argument("--parallel", type=int, default=2, help="Moco's parallel threads (the anchors used 2)")
+    ap.add_argument("--like-moco", action="store_true",
+                    help="our problem with Moco's activation dynamics and control periodicity")
     ap.add_argument("--work", type=Path, default=None)
     ap.add_argument("--json", type=Path, default=None, help="save the rows here")
     ap.add_argument("--table", type=Path, nargs="+", default=None,
@@ -134,7 +141,7 @@ def main() -> None:
     rows = []
     for mode in a.modes:
         if a.which in ("both", "ours"):
-            rows.append(run_ours(work, mode, a.mesh, a.points, a.tolerance))
+            rows.append(run_ours(work, mode, a.mesh, a.points, a.tolerance, a.like_moco))
             print(json.dumps(rows[-1]), flush=True)
         if a.which in ("both", "moco"):
             rows.append(run_moco(work, mode, a.mesh, a.tolerance, a.parallel))

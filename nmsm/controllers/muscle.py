@@ -18,8 +18,17 @@ Settings: ``muscle_list`` (default: every muscle of the geometry), ``surrogate_m
   DeGrooteFregly2016Muscle with ``ignore_tendon_compliance``: De Groote et al. 2016
   curves, fixed-width pennation, fiber damping; :func:`degroote_tendon_force`).
 
+**Activation dynamics** (``activation_dynamics`` true; default false): the controls are
+then the muscles' excitations ``e`` (``excitation:<muscle>``, in [``minimum_activation``, 1];
+a muscle's name in ``<controller_list>`` means its excitation) and each activation is a state
+``a`` (``activation:<muscle>``, same bounds) with OpenSim's DeGrooteFregly2016Muscle dynamics
+(:func:`degroote_activation_derivative`): time constants ``activation_time_constant`` and
+``deactivation_time_constant`` (s; default: each muscle's own values in the ``.osim``, else
+0.015 and 0.060) and each muscle's ``activation_dynamics_smoothing`` (else 0.1).
+Excitations are written to ``<trial>_muscleExcitations.sto``.
+
 Initial guess and ``controller_tracking`` reference: ``<trial>_combinedActivations.sto``
-when present, else 0.1.
+when present, else 0.1 (excitations and activations alike).
 """
 
 from __future__ import annotations
@@ -31,12 +40,17 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.core.plugin_bases import ControlSpec, Controller
+from nmsm.core.plugin_bases import ControlSpec, Controller, StateSpec
 from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
 from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
 
 PREFIX = "activation:"
+EXCITATION_PREFIX = "excitation:"
 DEFAULT_GUESS = 0.1
+#: DeGrooteFregly2016Muscle's default activation and deactivation time constants (s) and
+#: ``activation_dynamics_smoothing`` (OpenSim 4.6: the steepness b of the tanh switch)
+DGF_TIME_CONSTANTS = (0.015, 0.060)
+DGF_SMOOTHING = 0.1
 FORCE_MODELS = ("nmsm", "degroote2016")
 
 #: DeGrooteFregly2016Muscle active force-length Gaussians (amplitude, centre, width b3 + b4 l)
@@ -72,6 +86,19 @@ def degroote_tendon_force(a: Any, length: Any, velocity: Any, F0: Any, lo: Any, 
     f_p = (cs.exp(k * (l_norm - 1) / e0) - offset) / (np.exp(k) - offset)
     force = F0 * (a * f_l * f_v + f_p + damping * v_norm) * cos_alpha
     return force, l_norm, v_norm
+
+
+def degroote_activation_derivative(excitation: Any, activation: Any, activation_time_constant: Any,
+                                   deactivation_time_constant: Any, smoothing: Any = DGF_SMOOTHING) -> Any:
+    """da/dt (1/s) of OpenSim 4.6's DeGrooteFregly2016Muscle (De Groote et al. 2016, eq. 1-2
+    with a tanh switch): ``(e - a) [f / (τ_a (0.5 + 1.5 a)) + (1 - f) (0.5 + 1.5 a) / τ_d]``,
+    ``f = (1 + tanh(b (e - a))) / 2`` with ``b`` the muscle's ``activation_dynamics_smoothing``
+    (0.1 by default: a gentle blend of the two rates, checked against OpenSim); excitation
+    ``e`` and activation ``a`` dimensionless, time constants in s. Elementwise on SX/MX/DM."""
+    factor = 0.5 + 1.5 * activation
+    switch = 0.5 + 0.5 * cs.tanh(smoothing * (excitation - activation))
+    rate = switch / (activation_time_constant * factor) + (1 - switch) * factor / deactivation_time_constant
+    return rate * (excitation - activation)
 
 
 class PathGeometry:
@@ -179,6 +206,13 @@ class MuscleActivationController(Controller):
             damping = np.array([float(model.muscle(m).properties.get("fiber_damping", 0.0)) for m in self.muscles])
             self.muscle_model = DeGrooteMuscleModel(base.muscles, base.coordinates, base.surrogate, base.parameters,
                                                     base.pennation, base.vmax_factor, damping=damping)
+        self.activation_dynamics = bool(setting(settings, "activation_dynamics", False))
+        #: (M, 3) per muscle: activation and deactivation time constants (s), smoothing
+        self.activation_constants = np.array([
+            [_time_constant(settings, model, m, key, default)
+             for key, default in zip(("activation_time_constant", "deactivation_time_constant"), DGF_TIME_CONSTANTS)]
+            + [float(model.muscle(m).properties.get("activation_dynamics_smoothing", DGF_SMOOTHING))]
+            for m in self.muscles]).reshape(len(self.muscles), 3)
 
     @classmethod
     def from_settings(cls, settings: Any, setup: ControllerSetup) -> MuscleActivationController:
@@ -191,11 +225,29 @@ class MuscleActivationController(Controller):
         return np.full(np.size(times), DEFAULT_GUESS)
 
     def control_specs(self) -> list[ControlSpec]:
+        prefix = EXCITATION_PREFIX if self.activation_dynamics else PREFIX
         specs = []
         for m in self.muscles:
             guess = np.clip(self._values(self.setup.starting_splines(), self.setup.starting_times(), m), self.minimum, 1.0)
-            specs.append(ControlSpec(PREFIX + m, m, self.minimum, 1.0, guess, aliases=(m,)))
+            specs.append(ControlSpec(prefix + m, m, self.minimum, 1.0, guess, aliases=(m,)))
         return specs
+
+    def state_specs(self) -> list[StateSpec]:
+        if not self.activation_dynamics:
+            return []
+        times = self.setup.starting_node_times()
+        return [StateSpec(PREFIX + m, m, self.minimum, 1.0,
+                          np.clip(self._values(self.setup.starting_splines(), times, m), self.minimum, 1.0))
+                for m in self.muscles]
+
+    def state_dynamics(self) -> cs.Function | None:
+        if not self.activation_dynamics:
+            return None
+        M = len(self.muscles)
+        a, e = cs.SX.sym("a", M), cs.SX.sym("e", M)
+        k = cs.DM(self.activation_constants)
+        return cs.Function("activation_dynamics", [a, e],
+                           [degroote_activation_derivative(e, a, k[:, 0], k[:, 1], k[:, 2])])
 
     def controlled_coordinates(self) -> tuple[str, ...]:
         return self.coordinates
@@ -204,7 +256,8 @@ class MuscleActivationController(Controller):
         return self.muscles
 
     def muscle_activations(self, view: Any) -> cs.MX:
-        return cs.horzcat(*[view.control(PREFIX + m) for m in self.muscles])
+        read = view.controller_state if self.activation_dynamics else view.control
+        return cs.horzcat(*[read(PREFIX + m) for m in self.muscles])
 
     def _outputs(self, view: Any) -> cs.MX:
         return view.cached(f"muscle_controller:{id(self)}",
@@ -222,11 +275,27 @@ class MuscleActivationController(Controller):
                 "normalized_fiber_velocity": out[:, 2 * M + nc:]}.get(name)
 
     def control_reference(self, name: str, times: np.ndarray) -> np.ndarray:
-        muscle = name[len(PREFIX):] if name.startswith(PREFIX) else name
+        muscle = name
+        for prefix in (PREFIX, EXCITATION_PREFIX):
+            muscle = muscle[len(prefix):] if muscle.startswith(prefix) else muscle
         if muscle not in self.muscles:
             raise KeyError(f"muscle controller has no control '{name}'")
         return self._values(self.setup.initial_guess, np.asarray(times, dtype=float), muscle).reshape(-1, 1)
 
     def output_tables(self, solution: Any) -> dict[str, tuple[Sequence[str], np.ndarray]]:
-        values = np.hstack([solution.control(PREFIX + m) for m in self.muscles])
-        return {f"{solution.trial_name}_combinedActivations.sto": (self.muscles, values)}
+        if not self.activation_dynamics:
+            values = np.hstack([solution.control(PREFIX + m) for m in self.muscles])
+            return {f"{solution.trial_name}_combinedActivations.sto": (self.muscles, values)}
+        activations = np.hstack([solution.controller_state(PREFIX + m) for m in self.muscles])
+        excitations = np.hstack([solution.control(EXCITATION_PREFIX + m) for m in self.muscles])
+        return {f"{solution.trial_name}_combinedActivations.sto": (self.muscles, activations),
+                f"{solution.trial_name}_muscleExcitations.sto": (self.muscles, excitations)}
+
+
+def _time_constant(settings: Any, model: Any, muscle: str, key: str, default: float) -> float:
+    """A muscle's activation or deactivation time constant (s): the setting when given,
+    else the muscle's own property in the ``.osim``, else ``default``."""
+    value = setting(settings, key)
+    if value is None:
+        value = model.muscle(muscle).properties.get(key, default)
+    return float(value)

@@ -10,12 +10,14 @@ Controller life cycle (the treatment tool calls, in order)::
 
     c = Cls.from_settings(element_settings, setup)   # read data, check names (no CasADi yet)
     c.control_specs()                                # controls added to the phase
+    c.state_specs(), c.state_dynamics()              # the controller's own states, if any
     c.declare(problem)                               # static design variables (synergy weights)
     c.applied_loads(view), c.muscle_activations(view), ...   # symbolic, per grid, lazily
     c.output_tables(solution_view)                   # files written after the solve
 
 ``view`` is a :class:`nmsm.tools.treatment.context.GridView`: the controller reads its own
-controls with ``view.control(name)`` and the kinematics with ``view.positions()`` etc.
+controls with ``view.control(name)``, its own states with ``view.controller_state(name)``
+and the kinematics with ``view.positions()`` etc.
 
 Model modifier (Design Optimization ``<model_functions>``)::
 
@@ -61,6 +63,23 @@ class ControlSpec:
     offset: float | None = None
 
 
+@attrs.define
+class StateSpec:
+    """One state a controller adds to the phase (after the coordinates and speeds), e.g. a
+    muscle's activation under activation dynamics.
+
+    ``name``: internal, unique column name (e.g. ``activation:soleus_r``); ``label``: column
+    label in the output files; ``lower``/``upper``: bounds; ``guess``: (K + 1,) values at the
+    mesh nodes (the collocation points and the phase end).
+    """
+
+    name: str
+    label: str
+    lower: float
+    upper: float
+    guess: np.ndarray
+
+
 class Controller:
     """How a Treatment Optimization problem actuates the model (torque, synergy, ...).
 
@@ -83,6 +102,16 @@ class Controller:
     def control_specs(self) -> Sequence[ControlSpec]:
         """Controls added to the phase (after the joint accelerations), in order."""
         return ()
+
+    def state_specs(self) -> Sequence[StateSpec]:
+        """States added to the phase (after the coordinates and speeds), in order."""
+        return ()
+
+    def state_dynamics(self) -> cs.Function | None:
+        """``(x (n_x,), u (n_u,)) -> dx/dt (n_x,)`` of :meth:`state_specs` (physical time,
+        1/s) from the controller's own states ``x`` and controls ``u`` (:meth:`control_specs`
+        order), per point (SX); None when the controller has no states."""
+        return None
 
     def declare(self, problem: Any) -> None:
         """Declare static design variables in the OptimizationProblem (e.g. synergy weights)."""

@@ -19,7 +19,13 @@ contacts), set up as close as our formulation allows to the anchors' MocoTrack p
   muscle mode: pelvis unactuated (``root_segment_residual_load`` within the same bound),
   torque mode: torque controls on every coordinate (Moco's CoordinateActuators);
 * muscles: activations are the controls (Moco: excitations with activation dynamics),
-  DeGrooteFregly2016 rigid-tendon forces on the exact path geometry;
+  DeGrooteFregly2016 rigid-tendon forces on the exact path geometry; with
+  ``like_moco=True`` as in Moco: excitations are the controls (their squares are the
+  effort) and activations states with DeGrooteFregly2016 activation dynamics, periodic
+  r<->l, both starting from the midpoint of their bounds (Moco's default guess;
+  ``<trial>_combinedActivations.sto`` in the initial-guess folder);
+* ``like_moco=True`` also adds Moco's control periodicity: ``lumbar`` (both modes) and the
+  joint torques r<->l (torque mode);
 * reference: by default the raw table; the benchmark passes Moco's own 6 Hz low-pass
   filtered table (:func:`states_reference_table`) so both track the same data; bounds:
   range rule around the reference (Moco: the anchors' fixed bounds).
@@ -54,6 +60,9 @@ EFFORT_WEIGHT = 10.0
 GRF_WEIGHT = 1.0
 GRF_COLUMNS = ("ground_force_r_vx", "ground_force_r_vy", "ground_force_l_vx", "ground_force_l_vy")
 GRAVITY = 9.80665
+#: with ``like_moco``: the excitations' and activations' initial guess, the midpoint of their
+#: bounds [0.01, 1] (MocoCasADiSolver's default guess)
+MOCO_ACTIVATION_GUESS = 0.505
 MODES = ("torque", "muscle")
 
 
@@ -117,11 +126,12 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
                   max_iterations: int = 1000, dynamics_error: float = 1e-2, periodicity_error: float = 1e-4,
                   position_range_scale: float = 0.5, velocity_range_scale: float = 4.0,
                   acceleration_range_scale: float = 10.0, torque_range: float = 2000.0,
-                  reference: Table | None = None) -> MocoProblem:
+                  reference: Table | None = None, like_moco: bool = False) -> MocoProblem:
     """Write the ``mode`` ('torque' | 'muscle') problem under ``folder`` (created; nothing is
     written into ``data_dir``). ``reference``: the tracked coordinates (default: the raw
     ``referenceCoordinates.sto``; :func:`states_reference_table` gives Moco's 6 Hz filtered
-    one). Returns the paths and the objective factor."""
+    one). ``like_moco``: activation dynamics and control periodicity as Moco's problem
+    (module docstring). Returns the paths and the objective factor."""
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, not {mode!r}")
     folder = Path(folder)
@@ -161,11 +171,19 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
         n += 1
     muscle_block = ""
     if mode == "muscle":
-        costs.append(_cost("muscle_activation_minimization", 1.0 / math.sqrt(EFFORT_WEIGHT),
-                           muscle_list=" ".join(muscles)))
+        if like_moco:  # Moco's guess: the bounds' midpoint; its effort: squared excitations (the controls)
+            write_storage(tracked / f"{TRIAL}_combinedActivations.sto",
+                          table_from_columns(ik.time, {m: np.full(ik.time.size, MOCO_ACTIVATION_GUESS) for m in muscles},
+                                             name=TRIAL))
+            for m in muscles:
+                costs.append(_cost("controller_minimization", 1.0 / math.sqrt(EFFORT_WEIGHT), controller=m))
+        else:
+            costs.append(_cost("muscle_activation_minimization", 1.0 / math.sqrt(EFFORT_WEIGHT),
+                               muscle_list=" ".join(muscles)))
         n += len(muscles)
         muscle_block = ("<RCNLMuscleController><surrogate_model_coordinate_list>" + " ".join(MUSCLE_COORDINATES)
                         + "</surrogate_model_coordinate_list><muscle_force_model>degroote2016</muscle_force_model>"
+                        f"<activation_dynamics>{str(like_moco).lower()}</activation_dynamics>"
                         "<minimum_activation>0.01</minimum_activation></RCNLMuscleController>")
     constraints: list[str] = []
     for c in torque_coordinates:
@@ -181,6 +199,16 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
                                            pair_coordinate=_pair(c)))
         constraints.append(_constraint("generalized_speed_periodicity", periodicity_error, coordinate=c,
                                        pair_coordinate=_pair(c)))
+    if like_moco:
+        constraints.append(_constraint("controller_periodicity", periodicity_error, controller="lumbar"))
+        if mode == "torque":
+            for c in MUSCLE_COORDINATES:
+                constraints.append(_constraint("controller_periodicity", periodicity_error, controller=c,
+                                               pair_controller=_pair(c)))
+        else:
+            for m in muscles:
+                constraints.append(_constraint("muscle_activation_periodicity", periodicity_error, muscle=m,
+                                               pair_muscle=_pair(m)))
     results = folder / f"results_{mode}"
     solver = folder / "solver.xml"
     solver.write_text(f"""<?xml version="1.0" encoding="UTF-8"?>

@@ -125,6 +125,15 @@ class MuscleControllerSettings:
                                         doc="Lower bound of the activations")
     muscle_force_model: str = setting("muscle_force_model", kind="text", default="nmsm",
                                       choices=("nmsm", "degroote2016"), doc="Hill model: nmsm or degroote2016")
+    activation_dynamics: bool = setting(
+        "activation_dynamics", kind="boolean", default=False,
+        doc="Excitations as controls and activations as states with DeGrooteFregly2016 activation dynamics")
+    activation_time_constant: float | None = setting(
+        "activation_time_constant", kind="number", default=None, check=positive,
+        doc="Activation time constant (s); default: each muscle's value in the .osim, else 0.015")
+    deactivation_time_constant: float | None = setting(
+        "deactivation_time_constant", kind="number", default=None, check=positive,
+        doc="Deactivation time constant (s); default: each muscle's value in the .osim, else 0.060")
 
 
 @attrs.frozen(kw_only=True)

@@ -242,29 +242,48 @@ def moco_states_reference(coordinates_file: str, cutoff_frequency: float = 6.0) 
 
 @command
 def muscle_tendon_forces(model_file: str, coordinates: list[str], q: np.ndarray, u: np.ndarray,
-                         activation: np.ndarray) -> dict[str, Any]:
+                         activation: np.ndarray, excitation: np.ndarray | None = None) -> dict[str, Any]:
     """OpenSim's muscle outputs at given states: ``q``, ``u`` (k, len(coordinates)) rad, m,
     rad/s, m/s; ``activation`` (k, M) for the model's muscles in component order (state
     ``activation`` set directly). Returns ``names``, ``tendon_force`` (k, M) N,
-    ``normalized_fiber_length`` and ``normalized_fiber_velocity`` (k, M)."""
+    ``normalized_fiber_length`` and ``normalized_fiber_velocity`` (k, M); with ``excitation``
+    (k, M) (the muscles' controls, prescribed by a PrescribedController of constants) also
+    ``activation_derivative`` (k, M) 1/s, the activation state's derivative."""
     model = osim.Model(model_file)
+    q, u, activation = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, u, activation))
+    controls = None
+    if excitation is not None:
+        excitation = np.atleast_2d(np.asarray(excitation, dtype=float))
+        model.initSystem()
+        controller = osim.PrescribedController()
+        for muscle in _components(model, osim.Muscle):
+            controller.addActuator(muscle)
+            controller.prescribeControlForActuator(muscle.getName(), osim.Constant(0.0))
+        model.addController(controller)
     state = model.initSystem()
     coords = {c.getName(): c for c in _components(model, osim.Coordinate)}
     muscles = _components(model, osim.Muscle)
-    q, u, activation = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, u, activation))
+    if excitation is not None:
+        functions = controller.get_ControlFunctions()
+        controls = [osim.Constant.safeDownCast(functions.get(m)) for m in range(len(muscles))]
     if activation.shape[1] != len(muscles):
         raise ValueError(f"activation has {activation.shape[1]} columns, the model has {len(muscles)} muscles")
-    out = {k: np.zeros((q.shape[0], len(muscles)))
-           for k in ("tendon_force", "normalized_fiber_length", "normalized_fiber_velocity")}
+    names = ["tendon_force", "normalized_fiber_length", "normalized_fiber_velocity"]
+    out = {k: np.zeros((q.shape[0], len(muscles))) for k in names + (["activation_derivative"] if controls else [])}
     for k in range(q.shape[0]):
+        state.setTime(float(k))  # a new time invalidates every cached stage (controls included)
         for j, name in enumerate(coordinates):
             coords[name].setValue(state, float(q[k, j]), False)
             coords[name].setSpeedValue(state, float(u[k, j]))
         for m, muscle in enumerate(muscles):
             muscle.setActivation(state, float(activation[k, m]))
-        model.realizeDynamics(state)
+            if controls:
+                controls[m].setValue(float(excitation[k, m]))
+        model.realizeAcceleration(state) if controls else model.realizeDynamics(state)
         for m, muscle in enumerate(muscles):
             out["tendon_force"][k, m] = muscle.getTendonForce(state)
             out["normalized_fiber_length"][k, m] = muscle.getNormalizedFiberLength(state)
             out["normalized_fiber_velocity"][k, m] = muscle.getNormalizedFiberVelocity(state)
+            if controls:
+                out["activation_derivative"][k, m] = muscle.getStateVariableDerivativeValue(state, "activation")
     return dict(names=[m.getName() for m in muscles], **out)

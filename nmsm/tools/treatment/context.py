@@ -175,6 +175,11 @@ class GridView:
     def control(self, name: str) -> cs.MX:
         return self._q.control(self.grid, name)
 
+    def controller_state(self, name: str) -> cs.MX:
+        """(n, 1) a controller's own state (e.g. ``activation:<muscle>`` under activation
+        dynamics) by internal name."""
+        return self._q.controller_state(self.grid, name)
+
     def initial_control(self, name: str) -> cs.MX:
         return self._q.initial_control(self.grid, name)
 

@@ -1,8 +1,8 @@
 """What a controller receives when it is built (:meth:`Controller.from_settings`).
 
-Times: the controller's guesses are wanted at ``collocation_times`` (s, on the reference
-time base: normalized collocation time x ``reference_duration``); references are sampled
-later at any such times.
+Times: the controller's control guesses are wanted at ``collocation_times`` and its state
+guesses (controllers with states) at ``node_times`` (s, on the reference time base:
+normalized time x ``reference_duration``); references are sampled later at any such times.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ class ControllerSetup:
     labels, (S, M) values) when present; ``osimx``: the parsed ``.osimx`` (or None);
     ``model_file``: the ``.osim`` path (surrogate fitting, muscle parameters).
     ``guess`` / ``guess_times``: splines of the files the *starting point* is read from
-    (by default the initial-guess files) and the collocation times on their time base;
+    (by default the initial-guess files) and the collocation times on their time base
+    (``guess_node_times``: the mesh nodes);
     controllers take their controls' starting values from there and their references
     from ``initial_guess``.
     """
@@ -48,6 +49,8 @@ class ControllerSetup:
     trial_name: str = ""
     guess: Mapping[str, ReferenceSplines] | None = None
     guess_times: np.ndarray | None = None
+    node_times: np.ndarray | None = None
+    guess_node_times: np.ndarray | None = None
     #: controllers may write files (a fitted surrogate the settings ask to save); False when
     #: nothing is to be written (``write_results=False``, ``nmsm pipeline --check``)
     save_files: bool = True
@@ -58,6 +61,13 @@ class ControllerSetup:
 
     def starting_times(self) -> np.ndarray:
         return self.collocation_times if self.guess_times is None else self.guess_times
+
+    def starting_node_times(self) -> np.ndarray:
+        """(K + 1,) times (s) of the mesh nodes on the starting point's time base."""
+        times = self.node_times if self.guess_node_times is None else self.guess_node_times
+        if times is None:
+            raise ValueError("the controller setup has no mesh node times")
+        return times
 
     def error(self, message: str, *, element: str | None = None, expected: str | None = None) -> InputError:
         return InputError(message, file=self.settings_file, element=element, expected=expected)

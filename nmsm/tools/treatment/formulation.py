@@ -1,8 +1,9 @@
 """Assemble a TO/VO/DO optimal control problem (spec tools.md §8.2).
 
-Implicit dynamics: states are ``[q_s, q̇_s]`` of the ``states_coordinate_list``; controls
-are ``[q̈_s, controller controls...]``; the transcription enforces only ``d/dt q = q̇``,
-``d/dt q̇ = q̈``. Physics enters through terms (``kinetic_consistency``:
+Implicit dynamics: states are ``[q_s, q̇_s]`` of the ``states_coordinate_list`` followed
+by the controllers' own states (e.g. muscle activations under activation dynamics);
+controls are ``[q̈_s, controller controls...]``; the transcription enforces ``d/dt q = q̇``,
+``d/dt q̇ = q̈`` and each controller's state dynamics. Physics enters through terms (``kinetic_consistency``:
 inverse dynamics = controller loads; ``root_segment_residual_load``). Other coordinates
 are prescribed from splines of the tracked kinematics.
 
@@ -62,11 +63,22 @@ class TreatmentProblem:
     weights: dict[int, float]
 
 
-def _dynamics(n_s: int, n_u: int, n_p: int) -> cs.Function:
-    x = cs.SX.sym("x", 2 * n_s)
+def _dynamics(n_s: int, n_u: int, n_p: int, controllers: Sequence[Any] = ()) -> cs.Function:
+    """Per point ``(x, u, p) -> dx/dt``: ``[q̇_s, q̈_s]`` then each controller's state
+    derivatives from its own states and controls (their order in ``x`` and ``u``)."""
+    n_x = 2 * n_s + sum(len(c.state_specs()) for c in controllers)
+    x = cs.SX.sym("x", n_x)
     u = cs.SX.sym("u", n_u)
     p = cs.SX.sym("p", n_p)
-    return cs.Function("implicit_kinematics", [x, u, p], [cs.vertcat(x[n_s:], u[:n_s])])
+    parts = [x[n_s:2 * n_s], u[:n_s]]
+    x_at, u_at = 2 * n_s, n_s
+    for controller in controllers:
+        n_cx, n_cu = len(controller.state_specs()), len(controller.control_specs())
+        if n_cx:
+            (derivative,) = controller.state_dynamics().call([x[x_at:x_at + n_cx], u[u_at:u_at + n_cu]])
+            parts.append(derivative)
+        x_at, u_at = x_at + n_cx, u_at + n_cu
+    return cs.Function("implicit_kinematics", [x, u, p], [cs.vertcat(*parts)])
 
 
 def term_weights(terms: Sequence[Term], by_type: bool) -> dict[int, float]:
@@ -108,7 +120,8 @@ def build_problem(
     problem = OptimizationProblem(name)
     sc = data.state_coordinates
     n_s = len(sc)
-    state_names = tuple(sc) + tuple(speed_label(c) for c in sc)
+    state_specs = [spec for c in data.controllers for spec in c.state_specs()]
+    state_names = tuple(sc) + tuple(speed_label(c) for c in sc) + tuple(s.name for s in state_specs)
     control_specs = [spec for c in data.controllers for spec in c.control_specs()]
     control_names = tuple(f"{ACCEL_PREFIX}{c}" for c in sc) + tuple(s.name for s in control_specs)
     K = mesh.n_collocation
@@ -135,9 +148,12 @@ def build_problem(
     lo_t, hi_t = data.final_time_bounds
     phase = Phase(
         mesh=mesh,
-        states=Block(state_names, states.lower, states.upper, states.guess),
+        states=Block(state_names, np.r_[states.lower, [s.lower for s in state_specs]],
+                     np.r_[states.upper, [s.upper for s in state_specs]],
+                     np.hstack([states.guess.reshape(mesh.n_nodes, 2 * n_s)] +
+                               [np.asarray(s.guess, dtype=float).reshape(mesh.n_nodes, 1) for s in state_specs])),
         controls=Block(control_names, c_lower, c_upper, c_guess, c_scale, c_offset),
-        dynamics=_dynamics(n_s, len(control_names), 0),
+        dynamics=_dynamics(n_s, len(control_names), 0, data.controllers),
         final_time=FinalTime(data.final_time_guess, lo_t, hi_t),
     )
     transcription = transcription or RadauCollocation(parallel=parallel)

@@ -395,6 +395,10 @@ class ContextQuantities:
         _, internal = self._lookup(name)
         return self.trajectory.control(internal, grid)
 
+    def controller_state(self, grid: str, name: str) -> cs.MX:
+        """(n, 1) a controller's own state by internal name (``activation:<muscle>``)."""
+        return self.trajectory.state(name, grid)
+
     def initial_control(self, grid: str, name: str) -> cs.DM:
         controller, internal = self._lookup(name)
         return self.cache((grid, "initial_control", internal),

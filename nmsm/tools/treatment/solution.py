@@ -67,9 +67,18 @@ class TreatmentSolution:
         return self._controls[:, [list(names).index(name)]]
 
     @cached_property
-    def states(self) -> np.ndarray:
-        """(n, 2 n_s) [q_s, q̇_s]."""
+    def _all_states(self) -> np.ndarray:
         return self.value(self.built.trajectory.states(self.grid))
+
+    @property
+    def states(self) -> np.ndarray:
+        """(n, 2 n_s) [q_s, q̇_s] (the controllers' own states: :meth:`controller_state`)."""
+        return self._all_states[:, :2 * len(self.built.data.state_coordinates)]
+
+    def controller_state(self, name: str) -> np.ndarray:
+        """(n, 1) values of a controller's own state by internal name."""
+        names = self.built.trajectory.phase.states.names
+        return self._all_states[:, [list(names).index(name)]]
 
     @property
     def state_accelerations(self) -> np.ndarray:

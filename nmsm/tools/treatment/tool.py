@@ -269,6 +269,8 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     )
     setup.guess = _initial_guess_splines(guess_files)
     setup.guess_times = mesh.times("collocation") * t_guess
+    setup.node_times = mesh.times("nodes") * t_ref
+    setup.guess_node_times = mesh.times("nodes") * t_guess
     setup.extras["settings"] = settings
     setup.extras["files"] = files
     setup.extras["guess_files"] = guess_files
@@ -285,6 +287,9 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
         for spec in controller.control_specs():
             problems += check_guess_within("control", (spec.name,), spec.guess, np.array([spec.lower]),
                                            np.array([spec.upper]))
+        for state in controller.state_specs():
+            problems += check_guess_within("state", (state.name,), state.guess, np.array([state.lower]),
+                                           np.array([state.upper]))
     if problems:
         warnings.warn(f"{settings.settings_file}: the initial guess violates variable bounds (IPOPT starts from the "
                       "projection onto the bounds):\n  " + "\n  ".join(problems), stacklevel=2)

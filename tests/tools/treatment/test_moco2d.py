@@ -113,6 +113,37 @@ def test_degroote_muscle_forces_match_opensim(shared_data: Path, bridge) -> None
     assert np.abs(nmsm - ref["tendon_force"]).max() > 1.0
 
 
+def test_activation_dynamics_matches_opensim(shared_data: Path, bridge) -> None:
+    """da/dt of the controller's activation dynamics = OpenSim 4.6's DeGrooteFregly2016Muscle
+    state derivative for all 18 muscles at random activations and excitations."""
+    from nmsm.controllers.muscle import DGF_SMOOTHING, DGF_TIME_CONSTANTS, degroote_activation_derivative
+    from nmsm.model import load_model
+
+    path = shared_data.joinpath(*MODEL)
+    model = load_model(path)
+    names = [m.name for m in model.muscles]
+    rng = np.random.default_rng(11)
+    a = rng.uniform(0.01, 1, (8, len(names)))
+    e = rng.uniform(0.01, 1, a.shape)
+    e[0] = a[0]  # no change at e = a
+    zeros = np.zeros((len(a), len(MUSCLE_COORDINATES)))
+    ref = bridge.call("muscle_tendon_forces", model_file=str(path), coordinates=list(MUSCLE_COORDINATES), q=zeros,
+                      u=zeros, activation=a, excitation=e)
+    assert ref["names"] == names
+    tau = [(float(model.muscle(m).properties.get("activation_time_constant", DGF_TIME_CONSTANTS[0])),
+            float(model.muscle(m).properties.get("deactivation_time_constant", DGF_TIME_CONSTANTS[1]))) for m in names]
+    tau_a, tau_d = (np.array(t) for t in zip(*tau))
+    def rates(smoothing: float) -> np.ndarray:
+        return np.array([np.asarray(degroote_activation_derivative(e[k], a[k], tau_a, tau_d, smoothing)).ravel()
+                         for k in range(len(a))])
+
+    expected = ref["activation_derivative"]
+    assert np.abs(expected).max() > 10 and np.abs(expected[0]).max() == 0  # real rates (1/s); none at e = a
+    assert np.allclose(rates(DGF_SMOOTHING), expected, rtol=1e-10, atol=1e-10)
+    # the steepness of the switch matters: De Groote's b = 10 gives other rates
+    assert np.abs(rates(10.0) - expected).max() > 1.0
+
+
 def test_path_geometry_matches_full_model_geometry(shared_data: Path) -> None:
     from nmsm.controllers.muscle import PathGeometry
     from nmsm.model import load_model
@@ -195,3 +226,112 @@ def test_full_mesh_tracking_converges_and_tracks(shared_data: Path, tmp_path: Pa
     t, q, grf = read_solution(problem.results)
     err = tracking_error(data, t, q, grf, ref)
     assert err.coordinates_deg < 3.0 and err.grf_n < 30.0
+
+
+#: Moco 4.6's objectives of the anchors' runs (shared/anchors/RESULTS.md, items 1a and 2a)
+MOCO_OBJECTIVE = {"torque": 0.469259, "muscle": 1.530373}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mode", ["torque", "muscle"])
+def test_like_moco_problem_reaches_mocos_objective(shared_data: Path, tmp_path: Path, bridge, mode: str) -> None:
+    """With Moco's activation dynamics, control periodicity and guess (``like_moco``), the
+    50-interval problem is Moco's: our optimum's objective, in Moco's units, within -3 % / +1 %
+    of Moco's own (measured: torque +0.14 %, muscle -0.95 %; the transcriptions differ,
+    Radau vs Hermite-Simpson)."""
+    from nmsm.examples.moco2d import states_reference_table
+    from nmsm.tools.treatment.run import run_settings
+
+    data = shared_data / "moco2d"
+    ref = states_reference_table(bridge, data)
+    problem = write_problem(tmp_path / "w", data, mode, reference=ref, like_moco=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_settings(problem.settings, results_directory=problem.results,
+                           objective_scaling=problem.objective_factor, ipopt_options={"constr_viol_tol": 1e-4})
+    assert run.solution.success, run.summary
+    objective = run.cost * problem.objective_factor
+    assert 0.97 * MOCO_OBJECTIVE[mode] <= objective <= 1.01 * MOCO_OBJECTIVE[mode]
+    t, q, grf = read_solution(problem.results)
+    err = tracking_error(data, t, q, grf, ref)
+    assert err.coordinates_deg < 3.0 and err.grf_n < 15.0
+
+
+def test_settings_reader_parses_activation_dynamics(shared_data: Path, tmp_path: Path) -> None:
+    from nmsm.tools.treatment.run import load_settings
+
+    problem = write_problem(tmp_path / "w", shared_data / "moco2d", "muscle", mesh_intervals=4, like_moco=True)
+    settings, _ = load_settings(problem.settings)
+    mc = settings.muscle_controller
+    assert mc.activation_dynamics is True
+    assert mc.activation_time_constant is None and mc.deactivation_time_constant is None
+    plain = write_problem(tmp_path / "p", shared_data / "moco2d", "muscle", mesh_intervals=4)
+    assert load_settings(plain.settings)[0].muscle_controller.activation_dynamics is False
+
+
+def test_like_moco_muscle_problem_solves_with_activation_dynamics(shared_data: Path, tmp_path: Path) -> None:
+    """Excitations as controls, activations as states: activations within their bounds at every
+    node (the phase end too), periodic r<->l, and each activation follows its excitation by
+    the DeGrooteFregly2016 dynamics (checked on the solution by collocation's own derivative)."""
+    from nmsm.io.storage import read_storage
+    from nmsm.tools.treatment.run import run_settings
+
+    data = shared_data / "moco2d"
+    problem = write_problem(tmp_path / "w", data, "muscle", mesh_intervals=6, tolerance=1e-3, like_moco=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_settings(problem.settings, results_directory=problem.results,
+                           objective_scaling=problem.objective_factor)
+    assert run.solution.success, run.summary
+    act = read_storage(problem.results / "gait_combinedActivations.sto")
+    exc = read_storage(problem.results / "gait_muscleExcitations.sto")
+    assert act.labels == exc.labels and len(act.labels) == 18
+    assert act.data.min() >= 0.01 - 1e-6 and act.data.max() <= 1 + 1e-6  # states: bounded at t_f too
+    column = {m: j for j, m in enumerate(act.labels)}
+    for m in act.labels:
+        pair = m[:-2] + ("_l" if m.endswith("_r") else "_r")
+        assert abs(act.data[-1, column[m]] - act.data[0, column[pair]]) <= 1e-4 + 1e-6
+    # the activations lag the excitations (not equal to them)
+    assert np.abs(act.data[:-1] - exc.data[:-1]).max() > 0.01
+    # the phase dynamics give each activation state the derivative of its own muscle's excitation
+    from nmsm.controllers.muscle import DGF_SMOOTHING, degroote_activation_derivative
+
+    phase = run.prepared.built.trajectory.phase
+    states, controls = phase.states.names, phase.controls.names
+    assert states[-18:] == tuple(f"activation:{m}" for m in act.labels)
+    rng = np.random.default_rng(2)
+    x, u = rng.uniform(0.01, 1, len(states)), rng.uniform(0.01, 1, len(controls))
+    dx = np.asarray(phase.dynamics(x, u, np.zeros(0))).ravel()
+    a = x[[states.index(f"activation:{m}") for m in act.labels]]
+    e = u[[controls.index(f"excitation:{m}") for m in act.labels]]
+    expected = degroote_activation_derivative(e, a, 0.015, 0.060, DGF_SMOOTHING)  # the model's constants
+    assert np.allclose(dx[-18:], np.asarray(expected).ravel(), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("mode", ["torque", "muscle"])
+def test_like_moco_control_periodicity(shared_data: Path, tmp_path: Path, mode: str) -> None:
+    """``controller_periodicity``: the lumbar control (and in torque mode the joint torques
+    r<->l) end where their pair starts, as Moco's control pairs."""
+    from nmsm.io.storage import read_storage
+    from nmsm.tools.treatment.run import run_settings
+
+    problem = write_problem(tmp_path / "w", shared_data / "moco2d", mode, mesh_intervals=6, tolerance=1e-3,
+                            like_moco=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_settings(problem.settings, results_directory=problem.results,
+                           objective_scaling=problem.objective_factor)
+    assert run.solution.success, run.summary
+    torques = read_storage(problem.results / "gait_torqueControls.sto")
+    pairs = [("lumbar", "lumbar")]
+    if mode == "torque":
+        pairs += [(c, c[:-2] + ("_l" if c.endswith("_r") else "_r")) for c in MUSCLE_COORDINATES]
+    for c, pair in pairs:
+        end = torques.data[-1, torques.labels.index(_torque_label(torques.labels, c))]
+        start = torques.data[0, torques.labels.index(_torque_label(torques.labels, pair))]
+        assert abs(end - start) <= 1e-4 + 1e-6, (c, end, start)
+
+
+def _torque_label(labels, coordinate):
+    (label,) = [x for x in labels if x.startswith(coordinate)]
+    return label
