@@ -13,11 +13,20 @@ In each folder the exact spelling wins; otherwise each path component is matched
 case-insensitively (a warning names both spellings). Falling back to (2) or (3) warns too.
 A path that must exist and is found nowhere raises :class:`InputError` naming the settings
 file, line, element and every location tried.
+
+Separators: ``\\`` and ``/`` are the same everywhere (settings of the original MATLAB tool
+use back-slashes), so a back-slash in a settings path always separates folders, also on
+Linux and macOS, where it would otherwise be a legal character of a file name. An absolute
+Windows path (``C:\\Users\\...``, ``\\\\server\\share\\...``) names nothing on Linux or
+macOS: there it raises :class:`InputError` naming the element, before anything is read or
+written (a results folder would otherwise become a folder named ``C:``).
 """
 
 from __future__ import annotations
 
 import os
+import re
+import sys
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -26,6 +35,43 @@ from nmsm.errors import InputError
 
 #: what a resolved path must be
 KINDS = ("any", "file", "dir")
+#: whether paths are Windows paths here (a constant, so tests can pretend either way)
+ON_WINDOWS = os.name == "nt"
+_WINDOWS_DRIVE = re.compile(r"^[A-Za-z]:([\\/]|$)")
+
+
+def windows_absolute(text: str) -> str | None:
+    """What makes ``text`` an absolute Windows path (``drive C:`` or ``network share``), else None."""
+    stripped = text.strip()
+    if _WINDOWS_DRIVE.match(stripped):
+        return f"drive {stripped[:2]}"
+    if stripped.startswith("\\\\"):
+        return "network share"
+    return None
+
+
+def check_not_windows_absolute(
+    text: str,
+    *,
+    settings_file: str | os.PathLike[str] | None = None,
+    line: int | None = None,
+    element: str | None = None,
+) -> None:
+    """:class:`InputError` when ``text`` is an absolute Windows path and this is not Windows."""
+    if ON_WINDOWS:
+        return
+    what = windows_absolute(text)
+    if what is None:
+        return
+    system = "macOS" if sys.platform == "darwin" else "Linux" if sys.platform.startswith("linux") else sys.platform
+    raise InputError(
+        f"'{text.strip()}' is an absolute Windows path ({what}), which names no file or folder on {system}",
+        file=settings_file,
+        line=line,
+        element=element,
+        expected="a path relative to the settings file's folder (e.g. ..\\data\\model.osim) or an absolute "
+        "path of this system (e.g. /home/...)",
+    )
 
 
 def normalize_separators(text: str) -> str:
@@ -98,8 +144,9 @@ def resolve_path(
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}")
-    cleaned = normalize_separators(text)
     where = f"<{element}>" if element and not element.startswith("<") else element
+    check_not_windows_absolute(text, settings_file=settings_file, line=line, element=where)
+    cleaned = normalize_separators(text)
     path = Path(cleaned)
     settings_dir = Path(settings_file).resolve().parent if settings_file else Path.cwd()
     candidates: Sequence[tuple[Path, str | None]]
