@@ -33,6 +33,7 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
 from nmsm.io.numbers import full_precision
+from nmsm.io.text import BOM, read_text_file
 
 #: header keys the writer sets itself
 _WRITER_KEYS = ("version", "nRows", "nColumns", "inDegrees")
@@ -213,7 +214,7 @@ def read_storage(path: str | os.PathLike[str], *, allow_nan: NanPolicy | None = 
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        text = read_text_file(path)
     except OSError as exc:
         raise InputError(
             f"cannot read table: {exc.strerror or exc}", file=path, expected="a readable .sto/.mot file"
@@ -223,7 +224,7 @@ def read_storage(path: str | os.PathLike[str], *, allow_nan: NanPolicy | None = 
 
 def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy | None = None) -> Table:
     """Parse the text of a ``.sto`` / ``.mot`` file (see :func:`read_storage`)."""
-    lines = text.splitlines()
+    lines = text.removeprefix(BOM).splitlines()
     end = next((i for i, line in enumerate(lines) if line.strip().lower() == "endheader"), None)
     if end is None:
         raise InputError(

@@ -29,6 +29,7 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
 from nmsm.io.numbers import full_precision
+from nmsm.io.text import BOM, read_text_file
 
 #: metres per unit
 UNIT_SCALE: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
@@ -143,7 +144,7 @@ def read_trc(path: str | os.PathLike[str]) -> MarkerTable:
     """Read a ``.trc`` file; positions in metres (see module docstring)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        text = read_text_file(path)
     except OSError as exc:
         raise InputError(
             f"cannot read marker file: {exc.strerror or exc}", file=path, expected="a readable .trc file"
@@ -160,7 +161,7 @@ def _cells(line: str) -> list[str]:
 
 def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
     """Parse the text of a ``.trc`` file (see :func:`read_trc`)."""
-    lines = text.splitlines()
+    lines = text.removeprefix(BOM).splitlines()
     if len(lines) < 5 or not lines[0].startswith("PathFileType"):
         raise InputError(
             "not a marker file: the first line must start with 'PathFileType'",

@@ -34,11 +34,24 @@ def read_xml(path: str | Path) -> etree._ElementTree:
     """The XML tree of ``path`` (comments and layout kept); ModelError if it is not XML."""
     parser = etree.XMLParser(remove_blank_text=False, huge_tree=True)
     try:
-        return etree.parse(str(path), parser)
+        tree = etree.parse(str(path), parser)
     except OSError as exc:
         raise ModelError(f"cannot read the model file ({exc})", file=path) from None
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not a valid XML file ({exc})", file=path, expected="an OpenSim .osim file") from None
+    encoding = (tree.docinfo.encoding or "UTF-8").upper()
+    if encoding not in _UTF8_NAMES:
+        raise ModelError(
+            f"the model file is {tree.docinfo.encoding}-encoded; OpenSim reads (and nmsm writes) only UTF-8 "
+            "model files",
+            file=path, line=1, element="<?xml encoding?>",
+            expected='a UTF-8 .osim file: save it again as UTF-8 (e.g. Notepad: "Save as", encoding UTF-8) '
+            'with <?xml version="1.0" encoding="UTF-8"?>')
+    return tree
+
+
+#: encodings of an ``.osim`` file that OpenSim reads (ASCII is UTF-8)
+_UTF8_NAMES = frozenset({"UTF-8", "UTF8", "US-ASCII", "ASCII"})
 
 
 def file_version(tree: etree._ElementTree, path: str | Path) -> int:

@@ -17,6 +17,7 @@ import attrs
 import numpy as np
 
 from nmsm.errors import InputError
+from nmsm.io.text import read_text_file
 from nmsm.tools.ncp.nmf import nmf
 
 #: the thresholds the NMSM Pipeline recommends (fractions)
@@ -136,7 +137,7 @@ def _row_line(path: Path, label_line: int | None, row: int, time: float) -> int 
     are on ``label_line``, when its time reads ``time`` (else None: rows were dropped)."""
     if label_line is None:
         return None
-    lines = path.read_text(errors="replace").splitlines()
+    lines = read_text_file(path, warn=False).splitlines()  # as the table reader decoded it
     seen = -1
     for number in range(label_line + 1, len(lines) + 1):
         tokens = lines[number - 1].split()
