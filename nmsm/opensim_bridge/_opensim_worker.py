@@ -1,7 +1,9 @@
-"""The OpenSim worker process (``python -m nmsm.opensim_bridge._opensim_worker R W``).
+"""The OpenSim worker process (``python -m nmsm.opensim_bridge._opensim_worker``).
 
-Reads pickled ``(command, kwargs)`` requests from fd R and writes ``(ok, payload)`` to
-fd W. Never imports CasADi. OpenSim's log file is pinned to the worker's private folder
+Reads pickled ``(command, kwargs)`` requests from its standard input and writes
+``(ok, payload)`` to its standard output (:func:`protocol_streams`: the same on every
+system, see :mod:`nmsm.opensim_bridge.client`).
+Never imports CasADi. OpenSim's log file is pinned to the worker's private folder
 (``NMSM_BRIDGE_WORKDIR``) before any model is loaded, because OpenSim opens
 ``opensim.log`` lazily in whatever folder is current, and loading a model can change it.
 """
@@ -11,6 +13,7 @@ from __future__ import annotations
 import os
 import sys
 import traceback
+from typing import BinaryIO
 
 
 def _pin_opensim_log(workdir: str) -> None:
@@ -23,12 +26,41 @@ def _pin_opensim_log(workdir: str) -> None:
     osim.Logger.addFileSink(os.path.join(workdir, "opensim.log"))
 
 
+#: whether this is Windows (a constant, so tests can pretend)
+_WINDOWS = os.name == "nt"
+
+
+def _binary(fd: int) -> int:
+    """``fd``, in binary mode on Windows (no newline translation; Python starts its standard
+    streams binary, this makes sure for the duplicates)."""
+    if _WINDOWS:
+        import msvcrt
+
+        msvcrt.setmode(fd, os.O_BINARY)
+    return fd
+
+
+def protocol_streams() -> tuple[BinaryIO, BinaryIO]:
+    """The request and reply streams: this process's standard input and output, moved to
+    private descriptors. Descriptor 1 then writes to the log (descriptor 2) and descriptor 0
+    reads nothing, so neither OpenSim's console output nor a ``print`` can reach the replies."""
+    requests = os.fdopen(_binary(os.dup(0)), "rb")
+    replies = os.fdopen(_binary(os.dup(1)), "wb")
+    sys.stdout.flush()
+    os.dup2(2, 1)
+    devnull = os.open(os.devnull, os.O_RDONLY)
+    try:
+        os.dup2(devnull, 0)
+    finally:
+        os.close(devnull)
+    return requests, replies
+
+
 def main(argv: list[str]) -> int:
+    requests, replies = protocol_streams()  # first: nothing may write to the reply pipe but replies
     from nmsm.opensim_bridge.client import receive_message, send_message
     from nmsm.opensim_bridge.commands import COMMANDS, load_all
 
-    requests = os.fdopen(int(argv[1]), "rb")
-    replies = os.fdopen(int(argv[2]), "wb")
     workdir = os.environ.get("NMSM_BRIDGE_WORKDIR") or os.getcwd()
     os.chdir(workdir)
     try:

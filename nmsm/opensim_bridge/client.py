@@ -6,7 +6,11 @@ worker's current folder and ``opensim.log`` live in a private temporary folder, 
 the user's or the shared data folders.
 
 Messages are pickled ``(command, kwargs)`` requests and ``(ok, result_or_error)`` replies
-over a pair of pipes; OpenSim's console output goes to the worker's log file.
+over the worker's standard input and output, the only pipes a child inherits the same way
+on Linux, macOS and Windows (``subprocess``'s ``pass_fds`` is POSIX-only, and a file
+descriptor number means nothing to a Windows child). The worker moves its standard output
+to a private descriptor at once and points descriptor 1 at its log, so OpenSim's console
+output (and any ``print``) goes to the worker's log file, never into the reply pipe.
 
 Environment:
 ``NMSM_OPENSIM_PYTHON``  interpreter with ``opensim`` installed (default: this one).
@@ -101,8 +105,6 @@ class OpenSimBridge:
             raise
 
     def _start(self) -> None:
-        req_r, req_w = os.pipe()
-        rep_r, rep_w = os.pipe()
         env = dict(os.environ)
         package_root = str(Path(__file__).resolve().parents[2])
         env["PYTHONPATH"] = package_root + os.pathsep + env.get("PYTHONPATH", "")
@@ -110,23 +112,21 @@ class OpenSimBridge:
         log = open(self.log_path, "ab")
         try:
             self._proc = subprocess.Popen(
-                [self.python, "-m", "nmsm.opensim_bridge._opensim_worker", str(req_r), str(rep_w)],
-                stdin=subprocess.DEVNULL, stdout=log, stderr=log, cwd=self.workdir, env=env,
-                pass_fds=(req_r, rep_w), close_fds=True,
+                [self.python, "-m", "nmsm.opensim_bridge._opensim_worker"],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, cwd=self.workdir, env=env,
+                close_fds=True,
             )
         finally:
             log.close()
-            os.close(req_r)
-            os.close(rep_w)
-        self._requests = os.fdopen(req_w, "wb")
-        self._replies = os.fdopen(rep_r, "rb")
+        self._requests = self._proc.stdin
+        self._replies = self._proc.stdout
         ok, payload = self._exchange(("ping", {}))
         if not ok:
             raise BridgeError(f"OpenSim worker failed to start: {payload}")
 
     def _log_tail(self, n: int = 30) -> str:
         try:
-            lines = self.log_path.read_text(errors="replace").splitlines()
+            lines = self.log_path.read_text(errors="replace", encoding="utf-8").splitlines()
         except OSError:
             return ""
         return "\n".join(lines[-n:])
