@@ -55,7 +55,7 @@ def _discard_stdout() -> None:
     try:
         os.dup2(devnull, sys.stdout.fileno())
     except (AttributeError, OSError, ValueError, io.UnsupportedOperation):  # not a real file (tests)
-        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - replaces stdout until exit
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 - replaces stdout until exit
     finally:
         os.close(devnull)
 

@@ -291,7 +291,7 @@ class ResultsDirectory:
         with self.task(Path(relative).stem) as stage:
             target = stage / relative
             target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_text(text)
+            target.write_text(text, encoding="utf-8")
         return self.path / relative
 
     def copy_in(self, source: str | os.PathLike[str], relative: str | None = None) -> Path:

@@ -145,7 +145,7 @@ def prepare_example_folder(folder: str | os.PathLike[str], *, rebuild: bool = Fa
         shutil.rmtree(folder)
     if not folder.exists() or not any(folder.iterdir()):
         folder.mkdir(parents=True, exist_ok=True)
-        (folder / MARKER).write_text(MARKER_TEXT)
+        (folder / MARKER).write_text(MARKER_TEXT, encoding="utf-8")
     return folder
 
 

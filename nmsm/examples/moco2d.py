@@ -221,7 +221,7 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
  <setup_nlp_max_iterations>{max_iterations}</setup_nlp_max_iterations>
  <setup_display_level>0</setup_display_level>
 </GpopsSettings></OptimalControlSolverSettings></NMSMPipelineDocument>
-""")
+""", encoding="utf-8")
     cost_text = "\n  ".join(costs)
     constraint_text = "\n  ".join(constraints)
     settings = folder / f"to_{mode}.xml"
@@ -248,7 +248,7 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
   {constraint_text}
  </RCNLConstraintTermSet>
 </TrackingOptimizationTool></NMSMPipelineDocument>
-""")
+""", encoding="utf-8")
     return MocoProblem(settings, solver, results, n * duration, n, duration, mode)
 
 

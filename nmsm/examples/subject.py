@@ -102,7 +102,7 @@ def subject_in(folder: str | os.PathLike[str]) -> Subject | None:
 
 def read_truth(path: str | os.PathLike[str]) -> dict[str, Any]:
     """The truth file's content (see :func:`make_subject`)."""
-    return json.loads(Path(path).read_text())
+    return json.loads(Path(path).read_text(encoding="utf-8"))
 
 
 def _contact_surface(model, layout, constants):
@@ -277,7 +277,7 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
         "peak_vertical_force": float(simulation.force[:, 1].max()),
     }
     truth_file = truth_dir / "truth.json"
-    truth_file.write_text(json.dumps(truth, indent=1))
+    truth_file.write_text(json.dumps(truth, indent=1), encoding="utf-8")
     say(f"subject written to {folder} (peak vertical ground reaction {truth['peak_vertical_force']:.0f} N)")
     return Subject(folder=folder, generic_model=generic_model, true_model=true_model,
                    calibration_settings=jmp_case.settings_file, calibration_markers=jmp_case.marker_file,

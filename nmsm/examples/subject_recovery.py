@@ -67,7 +67,7 @@ def _check(stage: str, quantity: str, truth: float, recovered: float, tolerance:
 
 # ------------------------------------------------------------------------------------ JMP
 def jmp_checks(truth: dict[str, Any], results: Path) -> list[Check]:
-    data = json.loads((results / "jmp_results.json").read_text())
+    data = json.loads((results / "jmp_results.json").read_text(encoding="utf-8"))
     recovered: dict[str, float] = {}
     for task in data["tasks"]:
         for row in task.get("parameters", []):

@@ -351,7 +351,7 @@ def write_example_pipeline(subject: Subject, folder: str | os.PathLike[str], *, 
     """Write ``<folder>/pipeline.xml`` with ``stages`` (default: all available, in order)."""
     folder = Path(folder)
     (folder / "settings").mkdir(parents=True, exist_ok=True)
-    (folder / "settings" / "solver.xml").write_text(SOLVER_XML)
+    (folder / "settings" / "solver.xml").write_text(SOLVER_XML, encoding="utf-8")
     blocks = stage_blocks(subject, folder, n_synergies)
     chosen = [s for s in (stages or STAGES) if s in blocks]
     body = "\n    ".join(blocks[s] for s in chosen)
@@ -367,5 +367,5 @@ def write_example_pipeline(subject: Subject, folder: str | os.PathLike[str], *, 
     </StageList>
   </PipelineTool>
 </NMSMPipelineDocument>
-""")
+""", encoding="utf-8")
     return path

@@ -45,7 +45,7 @@ def _stages(root: Path) -> list[tuple[str, str, Path, str]]:
     """``(name, section kind, folder, description)`` of the stages in ``root``."""
     state = root / "pipeline_state.json"
     if state.is_file():
-        data = json.loads(state.read_text())
+        data = json.loads(state.read_text(encoding="utf-8"))
         out = []
         for name, record in data.get("stages", {}).items():
             section = KIND_SECTIONS.get(record.get("kind", ""))

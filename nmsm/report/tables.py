@@ -34,7 +34,7 @@ def _f(value: float | None, digits: int = 4) -> str:
 
 
 def jmp_tables(folder: Path) -> list[ReportTable]:
-    data = json.loads((folder / "jmp_results.json").read_text())
+    data = json.loads((folder / "jmp_results.json").read_text(encoding="utf-8"))
     out = []
     for task in data["tasks"]:
         rows = tuple((e["group"], str(len(e["markers"])), _f(1000 * e["rms_before"]), _f(1000 * e["rms_after"]),
@@ -88,11 +88,12 @@ def mtp_tables(folder: Path) -> list[ReportTable]:
 
 def ncp_tables(folder: Path) -> list[ReportTable]:
     log = folder / "commandWindowOutput.txt"
-    rows = tuple(("", line.strip()) for line in log.read_text().splitlines()[:12]) if log.is_file() else ()
+    lines = log.read_text(encoding="utf-8").splitlines()[:12] if log.is_file() else []
+    rows = tuple(("", line.strip()) for line in lines)
     out = [ReportTable("NCP run", ("", "summary"), rows)] if rows else []
     info = folder / "ncpRunInfo.json"
     if info.is_file():
-        data = json.loads(info.read_text())
+        data = json.loads(info.read_text(encoding="utf-8"))
         groups = tuple((g["name"], str(g["synergies"]), str(len(g["muscles"]))) for g in data.get("groups", []))
         out.append(ReportTable("NCP synergy groups", ("group", "synergies", "muscles"), groups))
     return out
@@ -116,7 +117,7 @@ def gcp_tables(folder: Path) -> list[ReportTable]:
                                 "resting length (mm)", "damping (s/m)", "dynamic friction", "viscous friction (s/m)"),
                                tuple(rows)))
     for errors in sorted(folder.glob("*_gcpErrors.txt")):
-        lines = [line.split() for line in errors.read_text().splitlines()[2:] if line.strip()]
+        lines = [line.split() for line in errors.read_text(encoding="utf-8").splitlines()[2:] if line.strip()]
         rows = tuple((" ".join(p[:-1]), p[-1]) for p in lines if len(p) >= 2)
         out.append(ReportTable("GCP RMS errors (modeled vs experimental)", ("quantity", "foot 1"), rows))
     return out
@@ -127,7 +128,7 @@ def treatment_tables(folder: Path) -> list[ReportTable]:
 
     out = []
     for convergence in sorted(folder.glob("*_convergence.txt")):
-        lines = convergence.read_text().splitlines()[:14]
+        lines = convergence.read_text(encoding="utf-8").splitlines()[:14]
         out.append(ReportTable(f"{convergence.stem}", ("",), tuple((line,) for line in lines)))
     modeled = sorted((folder / "Analysis").glob("*_modeledPositions.sto"))
     tracked = sorted((folder / "Analysis").glob("*_trackedPositions.sto"))
@@ -150,7 +151,8 @@ def analysis_tables(folder: Path) -> list[ReportTable]:
     report = folder / "analysis_report.txt"
     if not report.is_file():
         return []
-    return [ReportTable("IK, ID and muscle analysis", ("",), tuple((line,) for line in report.read_text().splitlines()))]
+    lines = report.read_text(encoding="utf-8").splitlines()
+    return [ReportTable("IK, ID and muscle analysis", ("",), tuple((line,) for line in lines))]
 
 
 def checks_table(checks: Sequence) -> ReportTable:

@@ -88,11 +88,11 @@ def moco_track_2d(model_file: str, coordinates_file: str, grf_file: str, workdir
         raise ValueError(f"mode must be 'muscle' or 'torque', not {mode!r}")
     os.makedirs(workdir, exist_ok=True)
     t_setup0 = time.perf_counter()
-    with open(grf_file.replace(".sto", ".xml")) as f:
+    with open(grf_file.replace(".sto", ".xml"), encoding="utf-8") as f:
         xml = f.read()
     xml = xml.replace(f"<datafile>{os.path.basename(grf_file)}</datafile>", f"<datafile>{grf_file}</datafile>")
     grf_xml = os.path.join(workdir, "referenceGRF_abs.xml")
-    with open(grf_xml, "w") as f:
+    with open(grf_xml, "w", encoding="utf-8") as f:
         f.write(xml)
     if mode == "torque":
         mp = _torque_model(model_file, workdir, reserve_optimal_force, residual_optimal_force)

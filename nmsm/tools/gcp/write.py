@@ -59,7 +59,7 @@ def write_results(stage: Path, settings: GroundContactPersonalizationSettings, g
     document = outputs.osimx_model(osimx, casadi_model.model.name, str(settings.input_model_file), surfaces)
     write_osimx(stage / f"{base_name}_gcp.osimx", document)
     (stage / f"{prefix}_gcpErrors.txt").write_text(
-        report.format_error_table({f"foot {k}": e for k, e in errors.items()}, "GCP RMS errors (nmsm)"))
+        report.format_error_table({f"foot {k}": e for k, e in errors.items()}, "GCP RMS errors (nmsm)"), encoding="utf-8")
     if not outputs.same_window(feet):
         warnings.warn("feet have different time windows: combined GRFData/IKData files are not written",
                       stacklevel=2)

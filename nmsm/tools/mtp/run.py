@@ -300,7 +300,7 @@ def write_results(outcome: MtpOutcome, results: ResultsDirectory, *, stopped_aft
         for t in outcome.tasks:
             lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
         lines.append(f"total wall time: {outcome.wall_time:.2f} s")
-        (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n")
+        (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOutcome:

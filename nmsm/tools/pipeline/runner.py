@@ -289,7 +289,7 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
         _raise_all([exc for _, exc in sorted(errors, key=lambda item: order.index(item[0]))])
     run = PipelineRun(spec, results, tuple(outcomes), time.perf_counter() - start)
     if not check_only:
-        (results / SUMMARY_FILE).write_text(run.summary() + "\n")
+        (results / SUMMARY_FILE).write_text(run.summary() + "\n", encoding="utf-8")
     return run
 
 
@@ -473,7 +473,7 @@ def _run_stage(stage: StageSpec, settings: StageSettings, settings_file: Path, f
     write_marker(folder, stage.name)
     state.claim(stage.name, _relative(folder, results))
     text = settings.text(settings_file, results)
-    settings_file.write_text(text)
+    settings_file.write_text(text, encoding="utf-8")
     began = time.perf_counter()
     try:
         result = stage.kind.load_run()(settings_file, **{**stage.kind.run_options, **options})

@@ -86,7 +86,7 @@ def _stale_error(path: Path, message: str, expected: str) -> InputError:
 
 def write_marker(folder: Path, name: str) -> None:
     """Mark ``folder`` as created by the runner for stage ``name``."""
-    (folder / MARKER).write_text(json.dumps({"format": MARKER_FORMAT, "stage": name}) + "\n")
+    (folder / MARKER).write_text(json.dumps({"format": MARKER_FORMAT, "stage": name}) + "\n", encoding="utf-8")
 
 
 def has_marker(folder: Path, name: str) -> bool:
@@ -95,7 +95,7 @@ def has_marker(folder: Path, name: str) -> bool:
     if marker.is_symlink() or not marker.is_file():
         return False
     try:
-        data = json.loads(marker.read_text())
+        data = json.loads(marker.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return False
     return isinstance(data, dict) and data.get("format") == MARKER_FORMAT and data.get("stage") == name
@@ -141,7 +141,7 @@ class PipelineState:
         if not path.is_file():
             return cls(results_directory)
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError) as exc:
             raise _stale_error(path, f"unreadable pipeline state ({exc})", f"a JSON file of format '{FORMAT}'") from None
         if not isinstance(data, dict) or data.get("format") != FORMAT:
@@ -208,7 +208,7 @@ class PipelineState:
         }
         handle, temporary = tempfile.mkstemp(prefix=".state-", dir=self.results_directory)
         try:
-            with os.fdopen(handle, "w") as out:
+            with os.fdopen(handle, "w", encoding="utf-8") as out:
                 json.dump(data, out, indent=2)
                 out.write("\n")
             os.replace(temporary, self.path)
@@ -222,7 +222,7 @@ def _salvage_folders(path: Path) -> dict[str, str]:
     ``stage_folders`` and its records' ``results_directory`` (empty when it is not JSON of
     this format)."""
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return {}
     if not isinstance(data, dict) or data.get("format") != FORMAT:
