@@ -17,6 +17,17 @@ from nmsm.examples.moco2d import (COORDINATES, GRF_COLUMNS, MUSCLE_COORDINATES, 
 MODEL = ("moco2d", "2D_gait.osim")
 
 
+def _solve(problem, **ipopt_options):
+    """Run a written problem's settings with its objective scaling (warnings silenced)."""
+    from nmsm.tools.treatment.run import run_settings
+
+    options = {"ipopt_options": ipopt_options} if ipopt_options else {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return run_settings(problem.settings, results_directory=problem.results,
+                            objective_scaling=problem.objective_factor, **options)
+
+
 class _Setup:
     """What ``SmoothSphereContact.discover`` reads from a problem's controller setup."""
 
@@ -183,14 +194,9 @@ def test_settings_reader_parses_the_muscle_controller(shared_data: Path, tmp_pat
 
 @pytest.mark.parametrize("mode", ["torque", "muscle"])
 def test_problem_solves_on_a_coarse_mesh(shared_data: Path, tmp_path: Path, mode: str) -> None:
-    from nmsm.tools.treatment.run import run_settings
-
     data = shared_data / "moco2d"
     problem = write_problem(tmp_path / "w", data, mode, mesh_intervals=6, tolerance=1e-3)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run = run_settings(problem.settings, results_directory=problem.results,
-                           objective_scaling=problem.objective_factor)
+    run = _solve(problem)
     assert run.solution.success, run.summary  # the tracked motion itself is not dynamically consistent:
     t, q, grf = read_solution(problem.results)
     assert set(q) == set(COORDINATES) and len(t) == 6 * 2 + 1
@@ -212,15 +218,10 @@ def test_full_mesh_tracking_converges_and_tracks(shared_data: Path, tmp_path: Pa
     """50 intervals, tolerance 1e-4, Moco's filtered reference: converges and tracks closely
     (bounds from our measured runs: docs/moco2d.md)."""
     from nmsm.examples.moco2d import states_reference_table
-    from nmsm.tools.treatment.run import run_settings
-
     data = shared_data / "moco2d"
     ref = states_reference_table(bridge, data)
     problem = write_problem(tmp_path / "w", data, mode, reference=ref)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run = run_settings(problem.settings, results_directory=problem.results,
-                           objective_scaling=problem.objective_factor, ipopt_options={"constr_viol_tol": 1e-4})
+    run = _solve(problem, constr_viol_tol=1e-4)
     assert run.solution.success, run.summary
     assert run.solution.iterations < 200
     t, q, grf = read_solution(problem.results)
@@ -240,15 +241,10 @@ def test_like_moco_problem_reaches_mocos_objective(shared_data: Path, tmp_path: 
     of Moco's own (measured: torque +0.14 %, muscle -0.95 %; the transcriptions differ,
     Radau vs Hermite-Simpson)."""
     from nmsm.examples.moco2d import states_reference_table
-    from nmsm.tools.treatment.run import run_settings
-
     data = shared_data / "moco2d"
     ref = states_reference_table(bridge, data)
     problem = write_problem(tmp_path / "w", data, mode, reference=ref, like_moco=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run = run_settings(problem.settings, results_directory=problem.results,
-                           objective_scaling=problem.objective_factor, ipopt_options={"constr_viol_tol": 1e-4})
+    run = _solve(problem, constr_viol_tol=1e-4)
     assert run.solution.success, run.summary
     objective = run.cost * problem.objective_factor
     assert 0.97 * MOCO_OBJECTIVE[mode] <= objective <= 1.01 * MOCO_OBJECTIVE[mode]
@@ -274,14 +270,9 @@ def test_like_moco_muscle_problem_solves_with_activation_dynamics(shared_data: P
     node (the phase end too), periodic r<->l, and each activation follows its excitation by
     the DeGrooteFregly2016 dynamics (checked on the solution by collocation's own derivative)."""
     from nmsm.io.storage import read_storage
-    from nmsm.tools.treatment.run import run_settings
-
     data = shared_data / "moco2d"
     problem = write_problem(tmp_path / "w", data, "muscle", mesh_intervals=6, tolerance=1e-3, like_moco=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run = run_settings(problem.settings, results_directory=problem.results,
-                           objective_scaling=problem.objective_factor)
+    run = _solve(problem)
     assert run.solution.success, run.summary
     act = read_storage(problem.results / "gait_combinedActivations.sto")
     exc = read_storage(problem.results / "gait_muscleExcitations.sto")
@@ -313,14 +304,9 @@ def test_like_moco_control_periodicity(shared_data: Path, tmp_path: Path, mode: 
     """``controller_periodicity``: the lumbar control (and in torque mode the joint torques
     r<->l) end where their pair starts, as Moco's control pairs."""
     from nmsm.io.storage import read_storage
-    from nmsm.tools.treatment.run import run_settings
-
     problem = write_problem(tmp_path / "w", shared_data / "moco2d", mode, mesh_intervals=6, tolerance=1e-3,
                             like_moco=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run = run_settings(problem.settings, results_directory=problem.results,
-                           objective_scaling=problem.objective_factor)
+    run = _solve(problem)
     assert run.solution.success, run.summary
     torques = read_storage(problem.results / "gait_torqueControls.sto")
     pairs = [("lumbar", "lumbar")]
