@@ -11,14 +11,18 @@ Two layouts, chosen by :meth:`SmoothSphereContact.discover`:
   (``GRFData/<trial>.sto``) have the columns ``ground_force_r_vx`` / ``ground_force_l_vx``,
   the force elements whose names end in ``_r`` (``_l``) are summed into one contact model
   ``ground_force_r`` (``ground_force_l``) with columns ``ground_force_<s>_vx|vy|vz``,
-  ``ground_torque_<s>_x|y|z`` (about the ground origin) and ``ground_force_<s>_px|py|pz``
-  (the normal-force weighted mean of the contact points). The Moco 2D gait reference
+  ``ground_torque_<s>_x|y|z`` and ``ground_force_<s>_px|py|pz``. The Moco 2D gait reference
   ``referenceGRF.sto`` has these columns.
 * **per element** otherwise: one model per force-applying element, columns
-  ``<name>_force_vx|vy|vz``, ``<name>_torque_x|y|z`` (about the ground origin) and
-  ``<name>_force_px|py|pz`` (contact point).
+  ``<name>_force_vx|vy|vz``, ``<name>_torque_x|y|z`` and ``<name>_force_px|py|pz``.
 
-Each element's force acts on its sphere's body at the contact point (N, m, ground).
+Each element's force acts on its sphere's body at the contact point (N, m, ground). The
+reported point is the contact point (per foot: the normal-force weighted mean of the
+contact points) projected on the ground (y = 0), and the torque is the reaction's moment
+about that point, so force, point and torque are an equivalent load (as an OpenSim
+ExternalForce applies them) and the moment is taken about the same kind of point as the
+tracked moment (``ContextQuantities.tracked_reaction``: the modeled point on the tracked
+kinematics, on the ground).
 """
 
 from __future__ import annotations
@@ -129,4 +133,6 @@ class SmoothSphereContact(ContactModel):
         else:
             # loads given as (force, point = ground origin, torque about the origin): equivalent
             point = weighted / (weight + 1e-6)
-        return cs.Function(f"contact_{self.name}", [q, qd, p], [loads, total, moment, point])
+        on_ground = cs.vertcat(point[0], 0, point[2])
+        about_point = moment - cs.cross(on_ground, total)
+        return cs.Function(f"contact_{self.name}", [q, qd, p], [loads, total, about_point, on_ground])

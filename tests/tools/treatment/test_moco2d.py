@@ -90,6 +90,31 @@ def test_foot_contact_models_match_opensim(shared_data: Path, bridge) -> None:
             assert np.allclose(tau, expected, atol=1e-8 * max(1.0, np.abs(expected).max()))
 
 
+def test_foot_reaction_is_an_equivalent_load_about_its_ground_point(shared_data: Path) -> None:
+    """Each foot's reported (force, point, torque): the point on the ground (y = 0) and the
+    torque its moment about that point, so that F at the point plus the torque has the
+    elements' moment about the ground origin (what an OpenSim ExternalForce applies)."""
+    from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
+
+    model = OsimTreatmentModel(shared_data.joinpath(*MODEL))
+    names = list(model.coordinate_names)
+    feet = SmoothSphereContact.discover(_Setup(model, GRF_COLUMNS))
+    elements = model.casadi.contact_force_function()
+    q, u = _states(names, 8, np.random.default_rng(9))
+    loaded = 0
+    for foot in feet:
+        f = foot.point_function(model)
+        for k in range(len(q)):
+            _, force, moment, point = (np.asarray(v).ravel() for v in f(q[k], u[k], np.zeros(0)))
+            forces, points = (np.asarray(v) for v in elements(q[k], u[k]))
+            about_origin = sum(np.cross(points[:, i], forces[:, i]) for i in foot.indices)
+            assert point[1] == 0.0
+            np.testing.assert_allclose(moment + np.cross(point, force), about_origin, rtol=0,
+                                       atol=1e-9 * max(1.0, np.abs(about_origin).max()))
+            loaded += force[1] > 50
+    assert loaded >= 4
+
+
 def test_degroote_muscle_forces_match_opensim(shared_data: Path, bridge) -> None:
     from nmsm.controllers.muscle import DeGrooteMuscleModel, PathGeometry
     from nmsm.model import load_model
