@@ -917,3 +917,43 @@ def test_individual_muscle_controller_bounds_and_fiber_length(shared_data: Path)
     l_norm = np.array([np.asarray(model.point_function()(q[k], qd[k], a[k], p)[2]).ravel() for k in range(len(q))])
     gasmed = l_norm[:, ctx.muscle_names.index("gasmed_r")]
     np.testing.assert_allclose(_constraint(built, fiber, x), _path(gasmed, fiber), rtol=1e-9)
+
+
+def test_center_of_pressure_divides_by_the_force_pushed_away_from_zero() -> None:
+    """Catalog §1.4: ``x = P_x + M_z/F̂_y``, ``z = P_z - M_x/F̂_y`` with ``F̂_y = F_y + sign(F_y)``
+    (sign(0) = 1), the same for the numeric (tracked) and the symbolic (modeled) path, for a
+    pulling (F_y < 0), a zero and a pushing force."""
+    import casadi as cs
+
+    from nmsm.tools.treatment.context import _cop
+
+    point = np.array([[0.1, 0.0, 0.2]] * 3)
+    force = np.array([[5.0, -4.0, 1.0], [5.0, 0.0, 1.0], [5.0, 600.0, 1.0]])
+    moment = np.array([[3.0, 7.0, 6.0]] * 3)
+    f_hat = np.array([-5.0, 1.0, 601.0])
+    expected = np.c_[0.1 + 6.0 / f_hat, np.zeros(3), 0.2 - 3.0 / f_hat]
+    np.testing.assert_allclose(_cop(point, force, moment), expected, rtol=1e-14)
+    symbolic = cs.Function("cop", [], [_cop(cs.MX(cs.DM(point)), cs.MX(cs.DM(force)), cs.MX(cs.DM(moment)))])
+    np.testing.assert_allclose(np.asarray(symbolic()["o0"]), expected, rtol=1e-14)
+
+
+def test_belt_speed_is_the_mean_over_the_surfaces_that_have_one() -> None:
+    """``belt_speed`` (used by the per-distance metabolic cost): the mean of the contact
+    surfaces' belt speeds, contact models without a belt (no parameters) not counted."""
+    from types import SimpleNamespace
+
+    import casadi as cs
+
+    from nmsm.model.foot_contact import CONTACT_PARAMETERS
+    from nmsm.tools.treatment.context import GridView
+
+    def surface(speed: float) -> SimpleNamespace:
+        values = [0.0] * len(CONTACT_PARAMETERS)
+        values[CONTACT_PARAMETERS.index("belt_speed")] = speed
+        return SimpleNamespace(values=values, set_parameter=lambda *a: None)
+
+    contacts = [surface(1.2), SimpleNamespace(name="sphere"), surface(1.6)]
+    view = SimpleNamespace(_q=SimpleNamespace(data=SimpleNamespace(contact_models=contacts)))
+    assert float(cs.evalf(GridView.belt_speed(view))) == pytest.approx(1.4, rel=1e-14)
+    view._q.data.contact_models = [SimpleNamespace(name="sphere")]
+    assert GridView.belt_speed(view) == 0.0
