@@ -2,7 +2,8 @@
 
 Reads pickled ``(command, kwargs)`` requests from its standard input and writes
 ``(ok, payload)`` to its standard output (:func:`protocol_streams`: the same on every
-system, see :mod:`nmsm.opensim_bridge.client`).
+system, see :mod:`nmsm.opensim_bridge.client`), after a start-up token
+(:data:`~nmsm.opensim_bridge.client.SYNC_TOKEN`) that tells the client where its replies begin.
 Never imports CasADi. OpenSim's log file is pinned to the worker's private folder
 (``NMSM_BRIDGE_WORKDIR``) before any model is loaded, because OpenSim opens
 ``opensim.log`` lazily in whatever folder is current, and loading a model can change it.
@@ -58,7 +59,10 @@ def protocol_streams() -> tuple[BinaryIO, BinaryIO]:
 
 def main(argv: list[str]) -> int:
     requests, replies = protocol_streams()  # first: nothing may write to the reply pipe but replies
-    from nmsm.opensim_bridge.client import receive_message, send_message
+    from nmsm.opensim_bridge.client import SYNC_TOKEN, receive_message, send_message
+
+    replies.write(SYNC_TOKEN)  # the client skips whatever start-up code printed before this
+    replies.flush()
     from nmsm.opensim_bridge.commands import COMMANDS, load_all
 
     workdir = os.environ.get("NMSM_BRIDGE_WORKDIR") or os.getcwd()

@@ -12,6 +12,11 @@ descriptor number means nothing to a Windows child). The worker moves its standa
 to a private descriptor at once and points descriptor 1 at its log, so OpenSim's console
 output (and any ``print``) goes to the worker's log file, never into the reply pipe.
 
+Whatever reaches standard output before the worker can move it (a ``sitecustomize.py``, a
+``.pth`` file, a wrapper set as ``NMSM_OPENSIM_PYTHON`` that prints before starting Python)
+still lands in the reply pipe, so the worker first writes :data:`SYNC_TOKEN`; the client
+skips everything before it (at most :data:`MAX_PREAMBLE` bytes, copied to the worker log).
+
 Environment:
 ``NMSM_OPENSIM_PYTHON``  interpreter with ``opensim`` installed (default: this one).
 """
@@ -34,6 +39,18 @@ from nmsm.errors import BridgeError
 
 _HEADER = struct.Struct("<Q")
 
+#: written by the worker as soon as its standard output is private: what comes before it is not ours
+SYNC_TOKEN = b"\x00\x01NMSM-OPENSIM-BRIDGE-SYNC-1\x01\x00"
+#: the most start-up output (bytes) the client skips while looking for :data:`SYNC_TOKEN`
+MAX_PREAMBLE = 1 << 20
+#: the largest message (bytes) a header may declare; more means the pipe carries something else
+MAX_MESSAGE = 1 << 32
+_CHUNK = 1 << 24
+
+
+class BridgeProtocolError(ValueError):
+    """What arrived in a bridge pipe is not a bridge message (garbage length or pickle)."""
+
 
 def send_message(stream: BinaryIO, obj: Any) -> None:
     data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
@@ -47,15 +64,49 @@ def receive_message(stream: BinaryIO) -> Any:
     if len(header) < _HEADER.size:
         raise EOFError("bridge pipe closed")
     (size,) = _HEADER.unpack(header)
+    if size > MAX_MESSAGE:
+        raise BridgeProtocolError(
+            f"a bridge message declares {size} bytes, more than the limit of {MAX_MESSAGE}: the header "
+            f"{header!r} is not a bridge message header (something else wrote to the pipe)")
     chunks = []
     remaining = size
-    while remaining:
-        chunk = stream.read(remaining)
+    while remaining:  # in bounded chunks: memory grows only with what really arrives
+        chunk = stream.read(min(remaining, _CHUNK))
         if not chunk:
-            raise EOFError("bridge pipe closed mid-message")
+            raise EOFError(f"bridge pipe closed mid-message ({size - remaining} of {size} bytes received)")
         chunks.append(chunk)
         remaining -= len(chunk)
-    return pickle.loads(b"".join(chunks))
+    data = b"".join(chunks)
+    try:
+        return pickle.loads(data)
+    except Exception as exc:  # UnpicklingError, but garbage can raise almost anything
+        raise BridgeProtocolError(
+            f"a bridge message of {size} bytes is not a valid pickle ({type(exc).__name__}: {exc}); "
+            f"it starts with {data[:60]!r}") from exc
+
+
+def await_sync(stream: BinaryIO, limit: int | None = None) -> bytes:
+    """Read ``stream`` up to and including :data:`SYNC_TOKEN`; return the bytes before it.
+
+    Raises EOFError (with the bytes read in ``.preamble``) if the stream ends first and
+    :class:`BridgeProtocolError` if more than ``limit`` bytes come before the token.
+    """
+    limit = MAX_PREAMBLE if limit is None else limit
+    seen = bytearray()
+    n = len(SYNC_TOKEN)
+    while True:
+        byte = stream.read(1)  # one at a time (buffered): not a byte past the token is consumed
+        if not byte:
+            error = EOFError(f"bridge pipe closed before the worker's start-up token ({len(seen)} bytes before)")
+            error.preamble = bytes(seen)  # type: ignore[attr-defined]
+            raise error
+        seen += byte
+        if seen[-n:] == SYNC_TOKEN:
+            return bytes(seen[:-n])
+        if len(seen) > limit + n:
+            raise BridgeProtocolError(
+                f"more than {limit} bytes arrived on the worker's standard output before its start-up "
+                f"token; they start with {bytes(seen[:200])!r}")
 
 
 def opensim_python() -> str:
@@ -120,7 +171,12 @@ class OpenSimBridge:
             log.close()
         self._requests = self._proc.stdin
         self._replies = self._proc.stdout
-        ok, payload = self._exchange(("ping", {}))
+        try:
+            self._await_sync()
+            ok, payload = self._exchange(("ping", {}))
+        except BaseException:  # no half-started worker left running
+            self._kill()
+            raise
         if not ok:
             raise BridgeError(f"OpenSim worker failed to start: {payload}")
 
@@ -131,6 +187,57 @@ class OpenSimBridge:
             return ""
         return "\n".join(lines[-n:])
 
+    def _kill(self) -> None:
+        if self._proc is not None and self._proc.poll() is None:
+            self._proc.kill()
+            try:
+                self._proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
+        for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
+            try:
+                if stream:
+                    stream.close()
+            except OSError:
+                pass
+
+    def _note_preamble(self, preamble: bytes) -> None:
+        """Copy start-up output found before the sync token into the worker log."""
+        if not preamble:
+            return
+        try:
+            with open(self.log_path, "ab") as log:
+                log.write(b"[nmsm] the worker's standard output before the bridge started (%d bytes, "
+                          b"from sitecustomize, a .pth file or a wrapper interpreter; skipped):\n" % len(preamble))
+                log.write(preamble if preamble.endswith(b"\n") else preamble + b"\n")
+        except OSError:
+            pass
+
+    def _await_sync(self) -> None:
+        """Skip whatever the interpreter printed before the worker's start-up token."""
+        try:
+            preamble = await_sync(self._replies)
+        except EOFError as exc:
+            self._note_preamble(getattr(exc, "preamble", b""))
+            try:
+                code = self._proc.wait(timeout=10) if self._proc else None
+            except subprocess.TimeoutExpired:
+                code = None
+            raise BridgeError(
+                f"OpenSim worker ({self.python}) stopped (exit code {code}) before it started the bridge: {exc}. "
+                f"Is NMSM_OPENSIM_PYTHON a Python interpreter with nmsm's dependencies? "
+                f"Worker log tail:\n{self._log_tail()}") from exc
+        except BridgeProtocolError as exc:
+            raise BridgeError(
+                f"OpenSim worker ({self.python}) did not start the bridge: {exc}. Something in that interpreter's "
+                f"start-up (sitecustomize, a .pth file, a wrapper) prints too much to standard output. "
+                f"Worker log tail:\n{self._log_tail()}") from exc
+        except OSError as exc:
+            raise BridgeError(
+                f"OpenSim worker ({self.python}): reading its start-up token failed: {exc}. "
+                f"Worker log tail:\n{self._log_tail()}") from exc
+        self._note_preamble(preamble)
+
     def _exchange(self, message: tuple[str, dict[str, Any]]) -> tuple[bool, Any]:
         try:
             send_message(self._requests, message)
@@ -140,6 +247,12 @@ class OpenSimBridge:
             raise BridgeError(
                 f"OpenSim worker ({self.python}) stopped (exit code {code}) during '{message[0]}': {exc}. "
                 f"Is the 'opensim' package installed (pip install opensim)? Worker log tail:\n{self._log_tail()}"
+            ) from exc
+        except (BridgeProtocolError, pickle.UnpicklingError, MemoryError, struct.error) as exc:
+            self._kill()  # the pipe is out of step: the next call starts a fresh worker
+            raise BridgeError(
+                f"OpenSim worker ({self.python}) sent a reply to '{message[0]}' that is not a bridge message "
+                f"({type(exc).__name__}: {exc}); the worker is stopped. Worker log tail:\n{self._log_tail()}"
             ) from exc
 
     def call(self, command: str, **kwargs: Any) -> Any:
