@@ -23,16 +23,20 @@ then the muscles' excitations ``e`` (``excitation:<muscle>``, in [``minimum_acti
 a muscle's name in ``<controller_list>`` means its excitation) and each activation is a state
 ``a`` (``activation:<muscle>``, same bounds) with OpenSim's DeGrooteFregly2016Muscle dynamics
 (:func:`degroote_activation_derivative`): time constants ``activation_time_constant`` and
-``deactivation_time_constant`` (s; default: each muscle's own values in the ``.osim``, else
-0.015 and 0.060) and each muscle's ``activation_dynamics_smoothing`` (else 0.1).
+``deactivation_time_constant`` (s; default: the ``.osimx``'s personalized values, else each
+muscle's own in the ``.osim``, else 0.015 and 0.060 with a warning: :func:`_time_constants`)
+and each muscle's ``activation_dynamics_smoothing`` (else 0.1).
 Excitations are written to ``<trial>_muscleExcitations.sto``.
 
 Initial guess and ``controller_tracking`` reference: ``<trial>_combinedActivations.sto``
-when present, else 0.1 (excitations and activations alike).
+when present, else 0.1; with activation dynamics the excitations' come from
+``<trial>_muscleExcitations.sto`` (a previous run's), else from the activations file with a
+warning, else 0.1.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -209,26 +213,40 @@ class MuscleActivationController(Controller):
         self.activation_dynamics = bool(setting(settings, "activation_dynamics", False))
         #: (M, 3) per muscle: activation and deactivation time constants (s), smoothing
         self.activation_constants = np.array([
-            [_time_constant(settings, model, m, key, default)
-             for key, default in zip(("activation_time_constant", "deactivation_time_constant"), DGF_TIME_CONSTANTS)]
+            [*_time_constants(settings, model, osimx, m, setup.settings_file)]
             + [float(model.muscle(m).properties.get("activation_dynamics_smoothing", DGF_SMOOTHING))]
-            for m in self.muscles]).reshape(len(self.muscles), 3)
+            for m in self.muscles]).reshape(len(self.muscles), 3) if self.activation_dynamics else np.zeros((0, 3))
 
     @classmethod
     def from_settings(cls, settings: Any, setup: ControllerSetup) -> MuscleActivationController:
         return cls(settings, setup)
 
-    def _values(self, splines: Mapping[str, Any], times: np.ndarray, muscle: str) -> np.ndarray:
-        table = splines.get("combinedActivations")
-        if table is not None and table.has(muscle):
-            return table.values(times, 0, [muscle]).ravel()
+    def _values(self, splines: Mapping[str, Any], times: np.ndarray, muscle: str, *,
+                excitation: bool = False) -> np.ndarray:
+        """(n,) a muscle's activations (or, with ``excitation`` under activation dynamics,
+        excitations) from the guess or reference files at ``times`` (s); 0.1 without a file."""
+        kinds = ("muscleExcitations", "combinedActivations") if excitation else ("combinedActivations",)
+        for kind in kinds:
+            table = splines.get(kind)
+            if table is not None and table.has(muscle):
+                if kind != kinds[0]:
+                    self._warn_excitations_from_activations(table)
+                return table.values(times, 0, [muscle]).ravel()
         return np.full(np.size(times), DEFAULT_GUESS)
+
+    def _warn_excitations_from_activations(self, table: Any) -> None:
+        if not getattr(self, "_warned_excitations", False):
+            self._warned_excitations = True
+            warnings.warn(f"{self.setup.settings_file}: no <trial>_muscleExcitations.sto among the initial-guess "
+                          f"files: the excitations start from (and controller_tracking tracks) the activations of "
+                          f"{getattr(table, 'source', None) or 'the activations file'}", stacklevel=2)
 
     def control_specs(self) -> list[ControlSpec]:
         prefix = EXCITATION_PREFIX if self.activation_dynamics else PREFIX
         specs = []
         for m in self.muscles:
-            guess = np.clip(self._values(self.setup.starting_splines(), self.setup.starting_times(), m), self.minimum, 1.0)
+            guess = np.clip(self._values(self.setup.starting_splines(), self.setup.starting_times(), m,
+                                         excitation=self.activation_dynamics), self.minimum, 1.0)
             specs.append(ControlSpec(prefix + m, m, self.minimum, 1.0, guess, aliases=(m,)))
         return specs
 
@@ -280,7 +298,8 @@ class MuscleActivationController(Controller):
             muscle = muscle[len(prefix):] if muscle.startswith(prefix) else muscle
         if muscle not in self.muscles:
             raise KeyError(f"muscle controller has no control '{name}'")
-        return self._values(self.setup.initial_guess, np.asarray(times, dtype=float), muscle).reshape(-1, 1)
+        return self._values(self.setup.initial_guess, np.asarray(times, dtype=float), muscle,
+                            excitation=self.activation_dynamics).reshape(-1, 1)
 
     def output_tables(self, solution: Any) -> dict[str, tuple[Sequence[str], np.ndarray]]:
         if not self.activation_dynamics:
@@ -292,10 +311,26 @@ class MuscleActivationController(Controller):
                 f"{solution.trial_name}_muscleExcitations.sto": (self.muscles, excitations)}
 
 
-def _time_constant(settings: Any, model: Any, muscle: str, key: str, default: float) -> float:
-    """A muscle's activation or deactivation time constant (s): the setting when given,
-    else the muscle's own property in the ``.osim``, else ``default``."""
-    value = setting(settings, key)
-    if value is None:
-        value = model.muscle(muscle).properties.get(key, default)
-    return float(value)
+def _time_constants(settings: Any, model: Any, osimx: Any, muscle: str, where: Any) -> tuple[float, float]:
+    """A muscle's activation and deactivation time constants (s), each from the first of: the
+    settings' ``<activation_time_constant>`` / ``<deactivation_time_constant>``; the ``.osimx``'s
+    personalized ``activation_time_constant`` (MTP; τ_d = 4 τ_a,
+    :func:`nmsm.model.hill.time_constants_from_osimx`); the muscle's own properties in the
+    ``.osim``; else DeGrooteFregly2016's defaults 0.015 / 0.060 s, with a warning."""
+    from nmsm.model.hill import time_constants_from_osimx
+
+    keys = ("activation_time_constant", "deactivation_time_constant")
+    personalized = getattr(getattr(osimx, "muscles", {}).get(muscle), "activation_time_constant", None)
+    from_osimx = time_constants_from_osimx(personalized) if personalized is not None else (None, None)
+    properties = model.muscle(muscle).properties
+    out = []
+    for key, osimx_value, default in zip(keys, from_osimx, DGF_TIME_CONSTANTS):
+        value = setting(settings, key)
+        value = osimx_value if value is None else value
+        value = properties.get(key) if value is None else value
+        if value is None:
+            warnings.warn(f"{where}: muscle '{muscle}' has no {key} (settings, .osimx or .osim): "
+                          f"{default} s (DeGrooteFregly2016's default)", stacklevel=3)
+            value = default
+        out.append(float(value))
+    return out[0], out[1]

@@ -23,7 +23,8 @@ contacts), set up as close as our formulation allows to the anchors' MocoTrack p
   ``like_moco=True`` as in Moco: excitations are the controls (their squares are the
   effort) and activations states with DeGrooteFregly2016 activation dynamics, periodic
   r<->l, both starting from the midpoint of their bounds (Moco's default guess;
-  ``<trial>_combinedActivations.sto`` in the initial-guess folder);
+  ``<trial>_combinedActivations.sto`` and ``<trial>_muscleExcitations.sto`` in the
+  initial-guess folder);
 * ``like_moco=True`` also adds Moco's control periodicity: ``lumbar`` (both modes) and the
   joint torques r<->l (torque mode);
 * reference: by default the raw table; the benchmark passes Moco's own 6 Hz low-pass
@@ -134,7 +135,7 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
     (module docstring). Returns the paths and the objective factor."""
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, not {mode!r}")
-    folder = Path(folder)
+    folder = Path(folder).resolve()  # the settings name absolute paths: runnable from anywhere
     data_dir = Path(data_dir).resolve()
     tracked = folder / "tracked"
     for sub in ("IKData", "IDData", "GRFData"):
@@ -172,9 +173,10 @@ def write_problem(folder: os.PathLike[str] | str, data_dir: os.PathLike[str] | s
     muscle_block = ""
     if mode == "muscle":
         if like_moco:  # Moco's guess: the bounds' midpoint; its effort: squared excitations (the controls)
-            write_storage(tracked / f"{TRIAL}_combinedActivations.sto",
-                          table_from_columns(ik.time, {m: np.full(ik.time.size, MOCO_ACTIVATION_GUESS) for m in muscles},
-                                             name=TRIAL))
+            guess = table_from_columns(ik.time, {m: np.full(ik.time.size, MOCO_ACTIVATION_GUESS) for m in muscles},
+                                       name=TRIAL)
+            for kind in ("combinedActivations", "muscleExcitations"):
+                write_storage(tracked / f"{TRIAL}_{kind}.sto", guess)
             for m in muscles:
                 costs.append(_cost("controller_minimization", 1.0 / math.sqrt(EFFORT_WEIGHT), controller=m))
         else:

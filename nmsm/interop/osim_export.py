@@ -34,6 +34,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxContactSurface, OsimxModel, read_osimx
+from nmsm.model.hill import time_constants_from_osimx
 from nmsm.model.osim_writer import OsimWriter, format_number, format_vector
 
 #: depth (m) at which exported Hunt-Crossley contact matches the GCP spring's force
@@ -104,9 +105,9 @@ def _activation_constants(model: etree._Element, osimx: OsimxModel) -> list[str]
         value = osimx.muscles[name].activation_time_constant
         if value is None:
             continue
-        tau = 0.01 * float(value)  # osimx unit: 0.01 s
-        _set_child(muscle, "activation_time_constant", format_number(tau))
-        _set_child(muscle, "deactivation_time_constant", format_number(4.0 * tau))
+        tau_a, tau_d = time_constants_from_osimx(value)
+        _set_child(muscle, "activation_time_constant", format_number(tau_a))
+        _set_child(muscle, "deactivation_time_constant", format_number(tau_d))
         done.append(name)
     return done
 

@@ -71,6 +71,15 @@ ACTIVATION_NONLINEARITY_G = (
 ACTIVE_WIDTH_FLOOR = 1e-20
 #: deactivation time constant / activation time constant
 DEACTIVATION_RATIO = 4.0
+#: unit of the ``.osimx``'s ``activation_time_constant`` (MTP's raw design variable), s
+OSIMX_TIME_CONSTANT_UNIT = 0.01
+
+
+def time_constants_from_osimx(value: float) -> tuple[float, float]:
+    """``(τ_a, τ_d)`` in s of an ``.osimx`` ``activation_time_constant`` (units of 0.01 s):
+    ``τ_a = 0.01 value``, ``τ_d = 4 τ_a`` (the pipeline's activation dynamics, tools.md §0.4)."""
+    tau = OSIMX_TIME_CONSTANT_UNIT * float(value)
+    return tau, DEACTIVATION_RATIO * tau
 #: default maximum shortening velocity, optimal fiber lengths per second
 DEFAULT_VMAX_FACTOR = 10.0
 #: default maximum muscle stress sigma0 (Pa) relating F0 to muscle volume

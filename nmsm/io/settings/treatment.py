@@ -122,7 +122,7 @@ class MuscleControllerSettings:
         "maximum_shortening_velocity_multiplier", kind="number", default=10.0, check=positive,
         doc="Maximum shortening velocity (optimal fiber lengths per second)")
     minimum_activation: float = setting("minimum_activation", kind="number", default=0.01, check=non_negative,
-                                        doc="Lower bound of the activations")
+                                        doc="Lower bound of the activations (and excitations)")
     muscle_force_model: str = setting("muscle_force_model", kind="text", default="nmsm",
                                       choices=("nmsm", "degroote2016"), doc="Hill model: nmsm or degroote2016")
     activation_dynamics: bool = setting(

@@ -4,7 +4,8 @@
 ``GRFData/<trial>`` (optional). ``initial_guess_directory``: optional ``IKData``/``IDData``
 and the files a previous TO/VO/DO wrote: ``<trial>_states.sto`` (``q``, ``q_u`` columns),
 ``<trial>_accelerations.sto``, ``<trial>_torqueControls.sto``, ``<trial>_synergyCommands.sto``,
-``<trial>_combinedActivations.sto`` and ``synergyWeights.sto``. Tracked data come from the
+``<trial>_combinedActivations.sto``, ``<trial>_muscleExcitations.sto`` (muscle controller with
+activation dynamics) and ``synergyWeights.sto``. Tracked data come from the
 tracked folder, the initial kinematics from the initial-guess folder (falling back to the
 tracked ones). Times are shifted to start at 0 (each file's start is kept in
 ``TreatmentFiles.start_times``); IK degrees become radians for the model's rotational
@@ -33,6 +34,7 @@ RESULT_FILES = {
     "torqueControls": "_torqueControls",
     "synergyCommands": "_synergyCommands",
     "combinedActivations": "_combinedActivations",
+    "muscleExcitations": "_muscleExcitations",
 }
 
 

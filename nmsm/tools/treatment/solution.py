@@ -77,8 +77,10 @@ class TreatmentSolution:
 
     def controller_state(self, name: str) -> np.ndarray:
         """(n, 1) values of a controller's own state by internal name."""
-        names = self.built.trajectory.phase.states.names
-        return self._all_states[:, [list(names).index(name)]]
+        names = list(self.built.trajectory.phase.states.names)
+        if name not in names:
+            raise KeyError(f"no state named '{name}' (have: {', '.join(names)})")
+        return self._all_states[:, [names.index(name)]]
 
     @property
     def state_accelerations(self) -> np.ndarray:

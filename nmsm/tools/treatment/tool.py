@@ -142,7 +142,7 @@ def _references(files: TreatmentFiles, model: TreatmentModel) -> dict[str, Refer
 
 def _initial_guess_splines(files: TreatmentFiles) -> dict[str, ReferenceSplines]:
     out = {}
-    for kind in ("torqueControls", "synergyCommands", "combinedActivations"):
+    for kind in ("torqueControls", "synergyCommands", "combinedActivations", "muscleExcitations"):
         table = files.results.get(kind)
         if table is not None:
             out[kind] = ReferenceSplines.from_table(table)

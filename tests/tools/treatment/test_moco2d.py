@@ -6,6 +6,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+import attrs
 import casadi as cs
 import numpy as np
 import pytest
@@ -346,3 +347,55 @@ def test_like_moco_control_periodicity(shared_data: Path, tmp_path: Path, mode: 
 def _torque_label(labels, coordinate):
     (label,) = [x for x in labels if x.startswith(coordinate)]
     return label
+
+
+def test_activation_time_constants_come_from_settings_osimx_model_or_default(shared_data: Path) -> None:
+    """Order: the settings' elements, the .osimx's personalized value (0.01 s units, τ_d = 4 τ_a),
+    the muscle's .osim properties, DeGrooteFregly2016's defaults with a warning."""
+    from types import SimpleNamespace
+
+    from nmsm.controllers.muscle import _time_constants
+    from nmsm.model import load_model
+
+    model = load_model(shared_data.joinpath(*MODEL))  # every muscle has 0.015 / 0.060 s
+    osimx = SimpleNamespace(muscles={"soleus_r": SimpleNamespace(activation_time_constant=2.5)})
+    assert _time_constants({}, model, None, "soleus_r", "s.xml") == (0.015, 0.060)
+    assert _time_constants({}, model, osimx, "soleus_r", "s.xml") == pytest.approx((0.025, 0.100), rel=1e-14)
+    assert _time_constants({}, model, osimx, "tib_ant_r", "s.xml") == (0.015, 0.060)
+    override = {"activation_time_constant": 0.02}
+    assert _time_constants(override, model, osimx, "soleus_r", "s.xml") == pytest.approx((0.02, 0.100), rel=1e-14)
+    bare = SimpleNamespace(muscle=lambda name: SimpleNamespace(properties={}))
+    with pytest.warns(UserWarning, match="no deactivation_time_constant"):
+        assert _time_constants({"activation_time_constant": 0.01}, bare, None, "m", "s.xml") == (0.01, 0.060)
+
+
+def test_a_run_from_activation_dynamics_results_starts_from_their_excitations(shared_data: Path,
+                                                                             tmp_path: Path) -> None:
+    """A TO with activation dynamics writes its excitations; a run with its results as the
+    initial guess starts its excitations there and tracks them with ``controller_tracking``
+    (not the activations, which lag them), and reaches the same optimum."""
+    import re
+
+    from nmsm.io.storage import read_storage
+
+    data = shared_data / "moco2d"
+    to = write_problem(tmp_path / "to", data, "muscle", mesh_intervals=6, tolerance=1e-3, like_moco=True)
+    first = _solve(to)
+    assert first.solution.success
+    excitations = read_storage(to.results / "gait_muscleExcitations.sto")
+    activations = read_storage(to.results / "gait_combinedActivations.sto")
+    assert np.abs(excitations.data - activations.data).max() > 0.05  # the two files differ
+    warm_settings = tmp_path / "to" / "warm.xml"
+    warm_settings.write_text(re.sub(r"<initial_guess_directory>[^<]*</initial_guess_directory>",
+                                    f"<initial_guess_directory>{to.results}</initial_guess_directory>",
+                                    to.settings.read_text()))
+    run = _solve(attrs.evolve(to, settings=warm_settings, results=tmp_path / "warm_results"))
+    assert run.solution.success
+    assert run.cost <= first.cost * (1 + 1e-3)
+    phase = run.prepared.built.trajectory.phase
+    columns = [phase.controls.names.index(f"excitation:{m}") for m in excitations.labels]
+    np.testing.assert_allclose(phase.controls.guess[:, columns], excitations.data[:-1], atol=1e-3)
+    (controller,) = [c for c in run.prepared.built.data.controllers if c.type == "individual_muscle"]
+    reference = controller.control_reference("excitation:soleus_r", excitations.time[:-1])
+    np.testing.assert_allclose(reference.ravel(), excitations.data[:-1, excitations.labels.index("soleus_r")],
+                               atol=1e-6)
