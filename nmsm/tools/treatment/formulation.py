@@ -63,19 +63,19 @@ class TreatmentProblem:
     weights: dict[int, float]
 
 
-def _dynamics(n_s: int, n_u: int, n_p: int, controllers: Sequence[Any] = ()) -> cs.Function:
+def _dynamics(n_s: int, n_u: int, n_p: int, blocks: Sequence[tuple[int, int, cs.Function | None]] = ()) -> cs.Function:
     """Per point ``(x, u, p) -> dx/dt``: ``[q̇_s, q̈_s]`` then each controller's state
-    derivatives from its own states and controls (their order in ``x`` and ``u``)."""
-    n_x = 2 * n_s + sum(len(c.state_specs()) for c in controllers)
+    derivatives from its own states and controls; ``blocks``: per controller, in order, its
+    state count, control count and state dynamics (their order in ``x`` and ``u``)."""
+    n_x = 2 * n_s + sum(n_cx for n_cx, _, _ in blocks)
     x = cs.SX.sym("x", n_x)
     u = cs.SX.sym("u", n_u)
     p = cs.SX.sym("p", n_p)
     parts = [x[n_s:2 * n_s], u[:n_s]]
     x_at, u_at = 2 * n_s, n_s
-    for controller in controllers:
-        n_cx, n_cu = len(controller.state_specs()), len(controller.control_specs())
+    for n_cx, n_cu, dynamics in blocks:
         if n_cx:
-            (derivative,) = controller.state_dynamics().call([x[x_at:x_at + n_cx], u[u_at:u_at + n_cu]])
+            (derivative,) = dynamics.call([x[x_at:x_at + n_cx], u[u_at:u_at + n_cu]])
             parts.append(derivative)
         x_at, u_at = x_at + n_cx, u_at + n_cu
     return cs.Function("implicit_kinematics", [x, u, p], [cs.vertcat(*parts)])
@@ -120,9 +120,11 @@ def build_problem(
     problem = OptimizationProblem(name)
     sc = data.state_coordinates
     n_s = len(sc)
-    state_specs = [spec for c in data.controllers for spec in c.state_specs()]
+    own = [(list(c.state_specs()), list(c.control_specs())) for c in data.controllers]
+    blocks = [(len(x), len(u), c.state_dynamics() if x else None) for c, (x, u) in zip(data.controllers, own)]
+    state_specs = [spec for x, _ in own for spec in x]
     state_names = tuple(sc) + tuple(speed_label(c) for c in sc) + tuple(s.name for s in state_specs)
-    control_specs = [spec for c in data.controllers for spec in c.control_specs()]
+    control_specs = [spec for _, u in own for spec in u]
     control_names = tuple(f"{ACCEL_PREFIX}{c}" for c in sc) + tuple(s.name for s in control_specs)
     K = mesh.n_collocation
     c_lower = np.concatenate([states.accel_lower, [s.lower for s in control_specs]])
@@ -153,7 +155,7 @@ def build_problem(
                      np.hstack([states.guess.reshape(mesh.n_nodes, 2 * n_s)] +
                                [np.asarray(s.guess, dtype=float).reshape(mesh.n_nodes, 1) for s in state_specs])),
         controls=Block(control_names, c_lower, c_upper, c_guess, c_scale, c_offset),
-        dynamics=_dynamics(n_s, len(control_names), 0, data.controllers),
+        dynamics=_dynamics(n_s, len(control_names), 0, blocks),
         final_time=FinalTime(data.final_time_guess, lo_t, hi_t),
     )
     transcription = transcription or RadauCollocation(parallel=parallel)
