@@ -8,6 +8,7 @@ the upgraded copy is read. Errors name the file the user gave.
 
 from __future__ import annotations
 
+import codecs
 import hashlib
 import os
 import tempfile
@@ -39,19 +40,43 @@ def read_xml(path: str | Path) -> etree._ElementTree:
         raise ModelError(f"cannot read the model file ({exc})", file=path) from None
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not a valid XML file ({exc})", file=path, expected="an OpenSim .osim file") from None
-    encoding = (tree.docinfo.encoding or "UTF-8").upper()
-    if encoding not in _UTF8_NAMES:
+    declared = tree.docinfo.encoding or "UTF-8"
+    if not ascii_compatible(declared):
         raise ModelError(
-            f"the model file is {tree.docinfo.encoding}-encoded; OpenSim reads (and nmsm writes) only UTF-8 "
-            "model files",
+            f"the model file is {declared}-encoded; OpenSim reads only model files in an ASCII-compatible "
+            "encoding (UTF-8, or a one-byte encoding such as ISO-8859-1 or windows-1252), not "
+            f"{declared}",
             file=path, line=1, element="<?xml encoding?>",
             expected='a UTF-8 .osim file: save it again as UTF-8 (e.g. Notepad: "Save as", encoding UTF-8) '
             'with <?xml version="1.0" encoding="UTF-8"?>')
     return tree
 
 
-#: encodings of an ``.osim`` file that OpenSim reads (ASCII is UTF-8)
-_UTF8_NAMES = frozenset({"UTF-8", "UTF8", "US-ASCII", "ASCII"})
+#: what ASCII text looks like in an encoding OpenSim can read (its XML parser reads bytes)
+_ASCII_PROBE = bytes(range(0x20, 0x7F)) + b"\t\r\n"
+#: encodings Python may not know by name that are never ASCII-compatible
+_WIDE_NAMES = ("UTF-16", "UTF16", "UTF-32", "UTF32", "UCS-2", "UCS2", "UCS-4", "UCS4", "UNICODE")
+
+
+def ascii_compatible(encoding: str) -> bool:
+    """Whether ``encoding`` writes ASCII characters as the same single bytes (UTF-8, ISO-8859-x,
+    windows-125x: OpenSim reads these; UTF-16/32, UCS-2/4 or EBCDIC it cannot)."""
+    name = encoding.strip().upper()
+    if name.startswith(_WIDE_NAMES):
+        return False
+    try:
+        return _ASCII_PROBE.decode("ascii").encode(codecs.lookup(encoding).name) == _ASCII_PROBE
+    except (LookupError, UnicodeError):
+        return True  # unknown to Python but read by libxml2: judged by name only
+
+
+def python_codec(tree: etree._ElementTree) -> str:
+    """The Python codec name of a parsed file's declared encoding (UTF-8 if none)."""
+    declared = tree.docinfo.encoding or "UTF-8"
+    try:
+        return codecs.lookup(declared).name
+    except LookupError:
+        return "utf-8"
 
 
 def file_version(tree: etree._ElementTree, path: str | Path) -> int:

@@ -30,7 +30,7 @@ from lxml import etree
 
 from nmsm.errors import ModelError
 from nmsm.model.functions import find_function
-from nmsm.model.osim import CURRENT_FORMAT, file_version, read_xml, upgraded_copy
+from nmsm.model.osim import CURRENT_FORMAT, file_version, python_codec, read_xml, upgraded_copy
 from nmsm.model.parse_forces import MUSCLE_TAGS
 from nmsm.model.xml_tree import XmlReader, component_path, in_defaults, resolve_path
 
@@ -65,7 +65,9 @@ class OsimWriter:
             self.source = upgraded_copy(self.path)
             tree = read_xml(self.source)
         self.tree = tree
-        self.text = self.source.read_text(encoding="utf-8")
+        #: the file's declared encoding (UTF-8, or e.g. ISO-8859-1, which OpenSim reads too), kept on writing
+        self.encoding = python_codec(tree)
+        self.text = self.source.read_text(encoding=self.encoding)
         self.reader = XmlReader(tree.getroot(), self.path)
         self._lines = self.text.splitlines(keepends=True)
         self._line_offsets = np.concatenate([[0], np.cumsum([len(line) for line in self._lines])]).astype(int)
@@ -308,7 +310,7 @@ class OsimWriter:
     def write(self, path: str | Path | None = None) -> Path:
         """Write the changed model (to ``path``, default: over the file read)."""
         target = Path(path) if path is not None else self.path
-        target.write_text(self.render(), encoding="utf-8")
+        target.write_text(self.render(), encoding=self.encoding, errors="xmlcharrefreplace")
         return target
 
     def _start_tag(self, elem: etree._Element) -> tuple[int, int, bool]:

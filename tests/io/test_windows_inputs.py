@@ -12,11 +12,12 @@ import pytest
 from lxml import etree
 
 from nmsm.cli import main
-from nmsm.errors import InputError, ModelError
+from nmsm.errors import BridgeError, InputError, ModelError
 from nmsm.io.settings.document import parse_settings_xml
 from nmsm.io.storage import read_storage
 from nmsm.io.trc import read_trc
 from nmsm.model.osim import load_model
+from nmsm.model.osim_writer import OsimWriter
 
 BOM = b"\xef\xbb\xbf"
 
@@ -120,14 +121,46 @@ def test_ansi_settings_file_names_the_line_and_the_encoding(arm: Path) -> None:
     assert "save the file as UTF-8" in info.value.expected and 'encoding="windows-1252"' in info.value.expected
 
 
-def test_utf16_model_is_refused_before_anything_runs(arm: Path) -> None:
+@pytest.mark.parametrize("encoding", ["UTF-16", "UTF-16LE"])
+def test_utf16_model_is_refused_before_anything_runs(arm: Path, encoding: str) -> None:
     text = (arm / "simple_arm.osim").read_text(encoding="utf-8")
     assert 'encoding="UTF-8"' in text
-    (arm / "utf16.osim").write_bytes(text.replace('encoding="UTF-8"', 'encoding="UTF-16"').encode("utf-16"))
+    (arm / "wide.osim").write_bytes(text.replace('encoding="UTF-8"', f'encoding="{encoding}"').encode(encoding))
     with pytest.raises(ModelError) as info:
-        load_model(arm / "utf16.osim")
-    assert "UTF-16" in info.value.detail and "only UTF-8" in info.value.detail
-    assert info.value.file == str(arm / "utf16.osim") and "save it again as UTF-8" in info.value.expected
+        load_model(arm / "wide.osim")
+    assert encoding in info.value.detail and "OpenSim reads only model files in an ASCII-compatible" in info.value.detail
+    assert info.value.file == str(arm / "wide.osim") and info.value.line == 1
+    assert "save it again as UTF-8" in info.value.expected
+
+
+def _latin1_model(arm: Path) -> Path:
+    """simple_arm.osim declared and saved as ISO-8859-1, with a non-ASCII comment and model name."""
+    text = (arm / "simple_arm.osim").read_text(encoding="utf-8")
+    text = text.replace('encoding="UTF-8"', 'encoding="ISO-8859-1"').replace('<Model name="arm26">',
+                                                                            '<Model name="arm26">\n<!-- Müller, 20°C -->', 1)
+    (arm / "latin1.osim").write_bytes(text.encode("latin-1", errors="xmlcharrefreplace"))
+    return arm / "latin1.osim"
+
+
+def test_latin1_model_loads_as_opensim_loads_it(arm: Path, bridge) -> None:
+    path = _latin1_model(arm)
+    assert bridge.call("model_info", path=str(path))["coordinates"] == ["r_elbow_flex"]  # OpenSim 4.6 reads it
+    assert [c.name for c in load_model(path).coordinates] == ["r_elbow_flex"]
+    wide = arm / "utf16.osim"  # and the reason for the rule: OpenSim cannot read UTF-16
+    wide.write_bytes((arm / "simple_arm.osim").read_text(encoding="utf-8")
+                     .replace('encoding="UTF-8"', 'encoding="UTF-16"').encode("utf-16"))
+    with pytest.raises(BridgeError):
+        bridge.call("model_info", path=str(wide))
+
+
+def test_latin1_model_is_written_back_in_its_own_encoding(arm: Path) -> None:
+    path = _latin1_model(arm)
+    writer = OsimWriter(path)
+    writer.set_marker_location("r_humerus1", [0.1, 0.2, 0.3])
+    writer.write(arm / "out.osim")
+    data = (arm / "out.osim").read_bytes()
+    assert "<!-- Müller, 20°C -->".encode("latin-1") in data  # still ISO-8859-1, as declared
+    assert b"0.1 0.2 0.3" in data and load_model(arm / "out.osim").coordinates[0].name == "r_elbow_flex"
 
 
 def test_model_with_bom_and_crlf_loads(arm: Path) -> None:
