@@ -50,6 +50,7 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
 from nmsm.io.numbers import significant15
+from nmsm.io.xml_input import parse_xml_file, xml_input_error
 
 #: version written when the model has none
 OSIMX_VERSION = "1.5.3"
@@ -455,12 +456,7 @@ def _serialize(element: etree._Element) -> str:
 def read_osimx(path: str | os.PathLike[str]) -> OsimxModel:
     """Read an ``.osimx`` file (see module docstring for compatibility rules)."""
     path = Path(path)
-    try:
-        root = etree.parse(str(path), etree.XMLParser(remove_blank_text=True)).getroot()
-    except OSError as exc:
-        raise InputError(f"cannot read .osimx file: {exc}", file=path, expected="a readable .osimx file") from exc
-    except etree.XMLSyntaxError as exc:
-        raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from exc
+    root = parse_xml_file(path, what=".osimx file", remove_blank_text=True)  # an "ANSI" file: its line, the fix
     return _Reader(path).read(root)
 
 
@@ -471,7 +467,7 @@ def parse_osimx(text: str | bytes, *, source: Path | None = None) -> OsimxModel:
             text.encode() if isinstance(text, str) else text, etree.XMLParser(remove_blank_text=True)
         )
     except etree.XMLSyntaxError as exc:
-        raise InputError(f"malformed XML: {exc.msg}", file=source, line=exc.lineno, expected="well-formed XML") from exc
+        raise xml_input_error(exc, source) from exc
     return _Reader(source).read(root)
 
 

@@ -14,6 +14,7 @@ from lxml import etree
 from nmsm.cli import main
 from nmsm.errors import BridgeError, InputError, ModelError
 from nmsm.io.settings.document import parse_settings_xml
+from nmsm.io.osimx import parse_osimx, read_osimx
 from nmsm.io.storage import read_storage
 from nmsm.io.trc import read_trc
 from nmsm.model.osim import load_model
@@ -119,6 +120,29 @@ def test_ansi_settings_file_names_the_line_and_the_encoding(arm: Path) -> None:
     line = 1 + text[: text.index("Müller")].count("\n")
     assert info.value.line == line and "not in the file's encoding" in str(info.value)
     assert "save the file as UTF-8" in info.value.expected and 'encoding="windows-1252"' in info.value.expected
+
+
+_OSIMX = "gcp/uf_subject3_tutorial/CompletedSettingsFiles/GCPResultsV1/bodyModel_gcp.osimx"
+
+
+def test_ansi_osimx_file_names_the_line_and_the_encoding(shared_data: Path, tmp_path: Path) -> None:
+    text = (shared_data / _OSIMX).read_text(encoding="utf-8")
+    text = text.replace("<!--File name of associated .osim file-->", "<!--Modell von Müller, 20°C-->", 1)
+    (tmp_path / "ansi.osimx").write_bytes(text.encode("cp1252"))  # Notepad's "ANSI", declared UTF-8
+    with pytest.raises(InputError) as info:
+        read_osimx(tmp_path / "ansi.osimx")
+    line = 1 + text[: text.index("Müller")].count("\n")
+    assert info.value.file == str(tmp_path / "ansi.osimx") and info.value.line == line
+    assert "not in the file's encoding" in info.value.detail
+    assert "save the file as UTF-8" in info.value.expected and 'encoding="windows-1252"' in info.value.expected
+    with pytest.raises(InputError, match="not in the file's encoding"):
+        parse_osimx(text.encode("cp1252"), source=tmp_path / "ansi.osimx")
+    declared = text.replace('encoding="utf-8"', 'encoding="windows-1252"', 1)
+    (tmp_path / "declared.osimx").write_bytes(declared.encode("cp1252"))  # the fix the message names
+    assert read_osimx(tmp_path / "declared.osimx").contact_surfaces
+    with pytest.raises(InputError, match="cannot read .osimx file") as info:
+        read_osimx(tmp_path / "missing.osimx")
+    assert info.value.expected == "a readable .osimx file"
 
 
 @pytest.mark.parametrize("encoding", ["UTF-16", "UTF-16LE"])

@@ -31,6 +31,7 @@ from lxml import etree
 from nmsm.core.term import SourceRef, TermSpec
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
+from nmsm.io.xml_input import parse_xml_file
 
 #: the NMSM Pipeline version whose settings schema nmsm reads
 PIPELINE_VERSION = (1, 5, 3)
@@ -375,29 +376,7 @@ def _many(what: str, count: int | None) -> str:
 # ----- reading ----------------------------------------------------------------------------
 def parse_settings_xml(path: str | os.PathLike[str]) -> etree._Element:
     """The root element of ``path`` (with line numbers); malformed XML -> :class:`InputError`."""
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise InputError(
-            f"cannot read settings file: {exc.strerror or exc}", file=path, expected="a readable XML file"
-        ) from exc
-    try:
-        return etree.fromstring(data, etree.XMLParser(remove_blank_text=False))
-    except etree.XMLSyntaxError as exc:
-        if exc.code == _ENCODING_ERROR:  # e.g. 'ü' saved by Notepad as "ANSI" (Windows-1252) in a UTF-8 file
-            raise InputError(
-                f"the text is not in the file's encoding ({exc.msg})",
-                file=path,
-                line=exc.lineno,
-                expected="UTF-8 text: save the file as UTF-8, or name its encoding in the first line, e.g. "
-                '<?xml version="1.0" encoding="windows-1252"?>',
-            ) from None
-        raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from None
-
-
-#: libxml2's code for bytes that are not valid in the file's (declared or default UTF-8) encoding
-_ENCODING_ERROR = etree.ErrorTypes.ERR_INVALID_ENCODING
+    return parse_xml_file(path, what="settings file")
 
 
 def tool_element_of(root: etree._Element, path: Path) -> etree._Element:

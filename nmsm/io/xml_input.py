@@ -1,0 +1,52 @@
+"""Errors for XML input files (settings, ``.osimx``) that name the line and the fix.
+
+A file saved by Notepad as "ANSI" (Windows-1252) that declares UTF-8, or declares nothing,
+has bytes such as ``ü`` that are not UTF-8: libxml2 reports ``ERR_INVALID_ENCODING``, and
+the user is told to save it as UTF-8 or to name its encoding (docs/install.md, "Files from
+Windows"). Every other syntax error is "malformed XML" at its line.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from lxml import etree
+
+from nmsm.errors import InputError
+
+#: libxml2's code for bytes that are not valid in the file's (declared or default UTF-8) encoding
+ENCODING_ERROR = etree.ErrorTypes.ERR_INVALID_ENCODING
+
+
+def xml_input_error(exc: etree.XMLSyntaxError, file: str | os.PathLike[str] | None) -> InputError:
+    """The :class:`InputError` for a syntax error ``exc`` of the XML file ``file``."""
+    if exc.code == ENCODING_ERROR:  # e.g. 'ü' saved by Notepad as "ANSI" (Windows-1252) in a UTF-8 file
+        return InputError(
+            f"the text is not in the file's encoding ({exc.msg})",
+            file=file,
+            line=exc.lineno,
+            expected="UTF-8 text: save the file as UTF-8, or name its encoding in the first line, e.g. "
+            '<?xml version="1.0" encoding="windows-1252"?>',
+        )
+    return InputError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno, expected="well-formed XML")
+
+
+def parse_xml_file(path: str | os.PathLike[str], *, what: str = "XML file",
+                   remove_blank_text: bool = False) -> etree._Element:
+    """The root element of the XML file ``path`` (with line numbers).
+
+    The bytes are read first and parsed from memory: lxml parsing a file by name reports bad
+    bytes as an ``OSError`` ("Invalid bytes in character encoding") with no line, while from
+    memory they are an ``XMLSyntaxError`` with its line. Unreadable file, bad encoding or
+    malformed XML -> :class:`InputError` naming the file (``what``: "settings file", ...).
+    """
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {what}: {exc.strerror or exc}", file=path,
+                         expected=f"a readable {what}") from exc
+    try:
+        return etree.fromstring(data, etree.XMLParser(remove_blank_text=remove_blank_text))
+    except etree.XMLSyntaxError as exc:
+        raise xml_input_error(exc, path) from None
