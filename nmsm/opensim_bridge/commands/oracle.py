@@ -399,7 +399,7 @@ def oracle_gcv_spline(times: np.ndarray, values: np.ndarray, at: np.ndarray, deg
     value, first and second derivative at ``at``, ``(3, len(at))``."""
     import tempfile
 
-    with tempfile.NamedTemporaryFile("w", suffix=".sto", delete=False) as handle:
+    with tempfile.NamedTemporaryFile("w", suffix=".sto", delete=False, encoding="utf-8") as handle:
         handle.write(f"spline\nversion=1\nnRows={len(times)}\nnColumns=2\ninDegrees=no\nendheader\ntime\ty\n")
         for t, v in zip(times, values):
             handle.write(f"{float(t)!r}\t{float(v)!r}\n")
