@@ -5,6 +5,9 @@
                  (set by ``.ci/run``).
 ``bridge``       the OpenSim worker; skips when ``opensim`` is not installed, fails instead
                  when ``NMSM_REQUIRE_OPENSIM=1``.
+``default_sigint`` Python's own SIGINT handler for the test (restored after): a pytest started
+                 in the background of a non-interactive shell (``nohup pytest ... &``) inherits
+                 SIGINT ignored, and tests of Ctrl-C need the handler an interactive run has.
 
 Never import opensim here or in any test module: OpenSim runs only in the bridge's worker.
 """
@@ -12,6 +15,8 @@ Never import opensim here or in any test module: OpenSim runs only in the bridge
 from __future__ import annotations
 
 import os
+import signal
+import threading
 from pathlib import Path
 
 import pytest
@@ -26,6 +31,19 @@ def _shared_data_dir() -> Path:
 
 def _require(flag: str) -> bool:
     return os.environ.get(flag, "") not in ("", "0", "false", "no")
+
+
+@pytest.fixture
+def default_sigint():
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signal handlers can only be set in the main thread")
+    previous = signal.getsignal(signal.SIGINT)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        # None: a handler not installed from Python, which cannot be put back; leave Python's
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

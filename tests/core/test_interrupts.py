@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import casadi as cs
 import numpy as np
@@ -18,7 +19,10 @@ import pytest
 
 from nmsm.core.problem import OptimizationProblem
 
-pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+pytestmark = [
+    pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals"),
+    pytest.mark.usefixtures("default_sigint"),  # also when pytest runs in the background (SIGINT ignored)
+]
 
 
 class _WaitsForSigint(cs.Callback):
@@ -83,3 +87,15 @@ def test_a_solve_without_interrupt_is_unchanged():
     assert solution.success
     np.testing.assert_allclose(solution["x"].ravel(), [3.0, 3.0], atol=1e-8)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_the_interrupt_tests_pass_when_pytest_starts_with_sigint_ignored():
+    """``nohup pytest ... &`` from a non-interactive shell starts pytest with SIGINT ignored
+    (SIG_IGN); the ``default_sigint`` fixture gives these tests Python's handler anyway."""
+    repo = Path(__file__).resolve().parents[2]
+    tests = [f"{Path(__file__).relative_to(repo)}::test_interrupt_during_ipopt_raises_keyboard_interrupt",
+             "tests/opensim_bridge/test_opensim_check_stop.py"]
+    result = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *tests], cwd=repo,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+                            capture_output=True, text=True, encoding="utf-8", timeout=600)
+    assert result.returncode == 0 and "2 passed" in result.stdout, result.stdout[-3000:] + result.stderr[-2000:]

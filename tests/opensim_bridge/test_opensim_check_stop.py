@@ -15,6 +15,8 @@ import pytest
 
 from nmsm.opensim_bridge import client
 
+pytestmark = pytest.mark.usefixtures("default_sigint")  # also when pytest runs in the background (SIGINT ignored)
+
 
 def test_a_stop_during_the_opensim_check_leaves_no_running_process(tmp_path: Path,
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
