@@ -11,12 +11,10 @@ import os
 import pickle
 import subprocess
 import sys
-import types
 from pathlib import Path
 
-import pytest
 
-from nmsm.opensim_bridge import _opensim_worker, client
+from nmsm.opensim_bridge import client
 from nmsm.opensim_bridge.client import OpenSimBridge, receive_message, send_message
 
 REPO = Path(__file__).resolve().parents[2]
@@ -69,13 +67,23 @@ def test_console_output_of_the_worker_never_reaches_the_replies(tmp_path: Path) 
     assert "console output of a print" in text and "written to descriptor 1" in text
 
 
-def test_worker_pipes_are_made_binary_on_windows(monkeypatch) -> None:
-    calls = []
-    monkeypatch.setattr(_opensim_worker, "_WINDOWS", True)
-    monkeypatch.setattr(_opensim_worker.os, "O_BINARY", 0x8000, raising=False)
-    monkeypatch.setitem(sys.modules, "msvcrt", types.SimpleNamespace(setmode=lambda fd, mode: calls.append((fd, mode))))
-    assert _opensim_worker._binary(7) == 7
-    assert calls == [(7, 0x8000)]
+#: every byte value, and the ones a text-mode (Windows) pipe would change: CR LF, lone CR and LF, Ctrl-Z (EOF)
+_ALL_BYTES = bytes(range(256)) + b"\r\n\n\r\x1a\r\n\x1a"
+
+
+def test_every_byte_crosses_the_worker_pipes_unchanged(tmp_path: Path) -> None:
+    """The worker's request and reply streams are binary: a pipe in text mode (newline
+    translation, Ctrl-Z as end of file on Windows) would change these bytes or cut the message."""
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    with (tmp_path / "worker.log").open("wb") as err:
+        proc = subprocess.Popen([sys.executable, "-c", _CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=err, env=env, cwd=tmp_path)
+        send_message(proc.stdin, {"raw": _ALL_BYTES, "text": "line 1\r\nline 2\n\x1a"})
+        proc.stdin.close()
+        reply = receive_message(proc.stdout)
+        proc.stdout.close()
+        assert proc.wait(timeout=60) == 0
+    assert reply == ("echo", {"raw": _ALL_BYTES, "text": "line 1\r\nline 2\n\x1a"})
 
 
 def test_messages_round_trip_through_a_pipe() -> None:
