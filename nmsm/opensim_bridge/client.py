@@ -194,6 +194,10 @@ class OpenSimBridge:
                 self._proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 pass
+        self._close_streams()
+
+    def _close_streams(self) -> None:
+        """Close the request and reply pipes (errors of an already broken pipe ignored)."""
         for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
             try:
                 if stream:
@@ -286,12 +290,7 @@ class OpenSimBridge:
                         self._proc.wait(timeout=10)  # reap the killed worker
                     except BaseException:  # noqa: BLE001 - already stopping; cleanup goes on
                         pass
-                for stream in (getattr(self, "_requests", None), getattr(self, "_replies", None)):
-                    try:
-                        if stream:
-                            stream.close()
-                    except OSError:
-                        pass
+                self._close_streams()
                 self._proc = None
                 shutil.rmtree(self.workdir, ignore_errors=True)
 
