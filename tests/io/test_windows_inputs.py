@@ -38,15 +38,6 @@ def _variants(data: bytes) -> dict[str, bytes]:
     }
 
 
-@pytest.fixture
-def arm(shared_data: Path, tmp_path: Path) -> Path:
-    folder = tmp_path / "arm"
-    shutil.copytree(shared_data / "jmp" / "toy_simple_arm", folder)
-    for path in folder.iterdir():
-        path.chmod(0o644)
-    return folder
-
-
 @pytest.mark.parametrize("variant", list(_variants(b"")))
 def test_marker_file_variants_read_as_the_original(arm: Path, variant: str) -> None:
     original = read_trc(arm / "simple_arm.trc")

@@ -3,7 +3,6 @@ Windows paths on Linux and macOS (the rule: docs/install.md, "Files from Windows
 
 from __future__ import annotations
 
-import shutil
 import warnings
 from pathlib import Path
 
@@ -13,15 +12,6 @@ from nmsm.cli import main
 from nmsm.errors import InputError
 from nmsm.io import paths
 from nmsm.io.paths import resolve_path
-
-
-@pytest.fixture
-def arm(shared_data: Path, tmp_path: Path) -> Path:
-    folder = tmp_path / "arm"
-    shutil.copytree(shared_data / "jmp" / "toy_simple_arm", folder)
-    for path in folder.iterdir():
-        path.chmod(0o644)
-    return folder
 
 
 # ----- paths in settings files --------------------------------------------------------------

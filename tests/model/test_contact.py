@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +22,39 @@ def test_contact_forces_match_opensim(shared_data: Path, bridge, model_cache) ->
     ref = bridge.call("oracle_contact_forces", path=model.source_file, q=q, u=u)
     assert ref["names"] == [f.name for f in model.contact_forces]
     assert ref["constant_contact_force"] == [f.constant_contact_force for f in model.contact_forces]
+    assert (np.abs(ref["forces"]).max(axis=2) > 10.0).sum() >= 20  # real contact, not only the smoothing tails
+    assert _largest_error(model, cm, q, u, ref) <= 1e-8 * max(1.0, np.abs(ref["forces"]).max())
+
+
+def test_smooth_sphere_stribeck_friction_matches_opensim(shared_data: Path, bridge, tmp_path: Path) -> None:
+    """The 2D model's spheres have equal static and dynamic friction (0.8), so the Stribeck term
+    ``2 (mu_s - mu_d) / (1 + v_r^2)`` is zero above; here mu_s = 1.2 > mu_d = 0.6 (found by
+    mutation testing: the term was unchecked)."""
+    from nmsm.model import CasadiModel, load_model
+
+    original = shared_data / "moco2d" / "2D_gait.osim"
+    text = original.read_text(encoding="utf-8")
+    text, n_static = re.subn(r"<static_friction>[^<]*</static_friction>", "<static_friction>1.2</static_friction>", text)
+    text, n_dynamic = re.subn(r"<dynamic_friction>[^<]*</dynamic_friction>", "<dynamic_friction>0.6</dynamic_friction>",
+                              text)
+    assert n_static == n_dynamic == 4
+    path = tmp_path / "2D_gait_stribeck.osim"
+    path.write_text(text, encoding="utf-8")
+    model = load_model(path)
+    assert {(f.static_friction, f.dynamic_friction) for f in model.contact_forces} == {(1.2, 0.6)}
+    q, u = _states(model, 25, np.random.default_rng(23))
+    ref = bridge.call("oracle_contact_forces", path=str(path), q=q, u=u)
+    plain = bridge.call("oracle_contact_forces", path=str(original), q=q, u=u)
+    # the sample reaches the Stribeck regime: OpenSim's forces change by tens of newtons
+    assert np.abs(ref["forces"] - plain["forces"]).max() > 20.0
+    assert _largest_error(model, CasadiModel(model), q, u, ref) <= 1e-8 * max(1.0, np.abs(ref["forces"]).max())
+
+
+def _largest_error(model, cm, q: np.ndarray, u: np.ndarray, ref: dict) -> float:
+    """Largest difference (N, N·m) of our element forces and their torques about the sphere
+    bodies' origins from OpenSim's ``oracle_contact_forces`` at the states ``q``, ``u``."""
     function = cm.contact_force_function()
     worst = 0.0
-    in_contact = 0
     for i in range(len(q)):
         forces, points = (np.array(v) for v in function(q[i], u[i]))
         for j, element in enumerate(model.contact_forces):
@@ -32,9 +63,7 @@ def test_contact_forces_match_opensim(shared_data: Path, bridge, model_cache) ->
             torque = np.cross(points[:, j] - origin, forces[:, j])
             worst = max(worst, np.abs(forces[:, j] - ref["forces"][i, j]).max(),
                         np.abs(torque - ref["torques"][i, j]).max())
-            in_contact += np.abs(ref["forces"][i, j]).max() > 10.0
-    assert in_contact >= 20  # the sample exercises real contact, not only the smoothing tails
-    assert worst <= 1e-8 * max(1.0, np.abs(ref["forces"]).max())
+    return worst
 
 
 def test_inverse_dynamics_with_contact_matches_opensim(shared_data: Path, bridge, model_cache) -> None:
