@@ -224,7 +224,7 @@ class MuscleActivationController(Controller):
     def _values(self, splines: Mapping[str, Any], times: np.ndarray, muscle: str, *,
                 excitation: bool = False) -> np.ndarray:
         """(n,) a muscle's activations (or, with ``excitation`` under activation dynamics,
-        excitations) from the guess or reference files at ``times`` (s); 0.1 without a file."""
+        excitations) from the guess files at ``times`` (s); ``DEFAULT_GUESS`` for a muscle without a column."""
         kinds = ("muscleExcitations", "combinedActivations") if excitation else ("combinedActivations",)
         for kind in kinds:
             table = splines.get(kind)

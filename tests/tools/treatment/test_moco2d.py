@@ -92,9 +92,10 @@ def test_foot_contact_models_match_opensim(shared_data: Path, bridge) -> None:
 
 
 def test_foot_reaction_is_an_equivalent_load_about_its_ground_point(shared_data: Path) -> None:
-    """Each foot's reported (force, point, torque): the point on the ground (y = 0) and the
-    torque its moment about that point, so that F at the point plus the torque has the
-    elements' moment about the ground origin (what an OpenSim ExternalForce applies)."""
+    """Each foot's reported (force, point, torque): the point on the ground (y = 0) below the
+    normal-force weighted mean of its contact points and the torque its moment about that
+    point, so that F at the point plus the torque has the elements' moment about the ground
+    origin (what an OpenSim ExternalForce applies)."""
     from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 
     model = OsimTreatmentModel(shared_data.joinpath(*MODEL))
@@ -110,6 +111,10 @@ def test_foot_reaction_is_an_equivalent_load_about_its_ground_point(shared_data:
             forces, points = (np.asarray(v) for v in elements(q[k], u[k]))
             about_origin = sum(np.cross(points[:, i], forces[:, i]) for i in foot.indices)
             assert point[1] == 0.0
+            # the point: the contact points' mean weighted by each element's |normal force|
+            normal = np.abs(forces[1, list(foot.indices)])
+            mean = points[:, list(foot.indices)] @ normal / (normal.sum() + 1e-6)
+            np.testing.assert_allclose(point[[0, 2]], mean[[0, 2]], rtol=0, atol=1e-12)
             np.testing.assert_allclose(moment + np.cross(point, force), about_origin, rtol=0,
                                        atol=1e-9 * max(1.0, np.abs(about_origin).max()))
             loaded += force[1] > 50
@@ -399,3 +404,21 @@ def test_a_run_from_activation_dynamics_results_starts_from_their_excitations(sh
     reference = controller.control_reference("excitation:soleus_r", excitations.time[:-1])
     np.testing.assert_allclose(reference.ravel(), excitations.data[:-1, excitations.labels.index("soleus_r")],
                                atol=1e-6)
+
+
+def test_muscle_activations_start_at_the_default_guess_without_a_file(shared_data: Path, tmp_path: Path) -> None:
+    """No ``<trial>_combinedActivations.sto`` in the initial-guess folder: every muscle's
+    activation starts at the controller's documented default (0.1) at every collocation point."""
+    from nmsm.tools.treatment.run import load_settings
+    from nmsm.tools.treatment.tool import TreatmentOptions, prepare
+
+    problem = write_problem(tmp_path / "w", shared_data / "moco2d", "muscle", mesh_intervals=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        settings, solver = load_settings(problem.settings)
+        built = prepare(settings, solver, TreatmentOptions()).built
+    assert not list(Path(settings.initial_guess_directory).glob("*_combinedActivations.sto"))
+    x0 = np.clip(built.problem.initial_scaled(), *built.problem.bounds_scaled())
+    activations = np.asarray(built.problem.evaluate(cs.MX(built.context.muscle_activations()), x0))
+    assert activations.shape[1] == 18
+    np.testing.assert_allclose(activations, 0.1, rtol=0, atol=1e-12)  # the value docs/treatment.md states
