@@ -15,6 +15,7 @@ Entry point: :func:`nmsm.tools.gcp.run.run_settings` (``nmsm run`` dispatches
 ``context``      what the cost terms (``nmsm/terms/gcp``) ask for, and GCP's reduction
 ``problem``      one task as an ``OptimizationProblem``; solver options
 ``solver``       the task's solve, exact Jacobians through the lifted foot coordinates
+``blas_threads`` one OpenBLAS thread while the solver runs
 ``rest_length``  initial resting spring length
 ``outputs``, ``write``, ``filtering``, ``ik_update``  result files (tools.md §6.7)
 ``report``       the RMS error table (Table 4 layout); ``compare`` scores finished results

@@ -3,6 +3,7 @@
 Modules (one job each):
 
 ``data``, ``context``      trials (EMG, muscle-tendon lengths/velocities, moment arms, ID moments) as arrays
+``model_info``             the muscles of the tracked coordinates and their parameters (model + ``.osimx``)
 ``muscles``, ``model``     the Hill-type muscle model of :mod:`nmsm.model.hill` applied to MTP design variables
 ``emg_spline``             EMG interpolation for electromechanical delays
 ``synx``                   Synergy Extrapolation for muscles without EMG
