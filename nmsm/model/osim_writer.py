@@ -69,8 +69,11 @@ class OsimWriter:
         self.encoding = python_codec(tree)
         self.text = self.source.read_text(encoding=self.encoding)
         self.reader = XmlReader(tree.getroot(), self.path)
-        self._lines = self.text.splitlines(keepends=True)
-        self._line_offsets = np.concatenate([[0], np.cumsum([len(line) for line in self._lines])]).astype(int)
+        # lines as the XML parser numbers them: ends at "\n" only (str.splitlines also ends lines
+        # at U+0085, U+2028, U+2029, which are text in XML: an edit would land lines too early)
+        lines = self.text.split("\n")
+        lengths = [len(line) + 1 for line in lines[:-1]] + [len(lines[-1])]
+        self._line_offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(int)
         self._edits: dict[Any, tuple[etree._Element, str, str]] = {}  # key -> (parent, tag, new text)
         self._frames = {component_path(e): e for e in self.reader.elements(["Ground", "Body", "PhysicalOffsetFrame"])}
 

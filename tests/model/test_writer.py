@@ -50,6 +50,31 @@ def test_changes_touch_only_their_elements(shared_data: Path, tmp_path: Path, br
     assert summary["markers"]["C7"]["location"] == [-0.07, 0.44, 0.001]
 
 
+def test_edits_land_on_their_elements_after_unicode_line_separators(shared_data: Path, tmp_path: Path) -> None:
+    """Python's ``splitlines`` also ends lines at U+0085 (byte 0x85, Windows' "…", in an
+    ISO-8859-1 file), U+2028 and U+2029, which XML treats as text: the writer numbers lines as
+    the parser does, so an edit after such characters lands on its own element."""
+    text = (shared_data / "models" / "RCNL2024.osim").read_text(encoding="utf-8")
+    text = text.replace('encoding="UTF-8"', 'encoding="ISO-8859-1"', 1)
+    notes = "pasted notes, ten Windows ellipses" + "\x85" * 10 + " and two separators\u2028\u2029"
+    text = text.replace("\t<Model ", f"\t<!-- {notes} -->\n\t<Model ", 1)
+    source = tmp_path / "latin1.osim"
+    source.write_bytes(text.encode("latin-1", errors="xmlcharrefreplace"))
+    before = load_model(source)
+    writer = OsimWriter(source)
+    edited = {"C7": [-0.07, 0.44, 0.001], "R_Asis": [0.01, 0.02, 0.03], "L_Heel": [-0.1, 0.0, 0.2]}
+    for name, location in edited.items():
+        writer.set_marker_location(name, location)
+    writer.set_muscle_property("soleus_r", "optimal_fiber_length", 0.0451)
+    after = load_model(writer.write(tmp_path / "out.osim"))
+    moved = {m.name for m in before.markers if not np.array_equal(m.location, after.marker(m.name).location)}
+    assert moved == set(edited)
+    assert all(list(after.marker(n).location) == loc for n, loc in edited.items())
+    changed = {m.name for m in before.muscles
+               if m.optimal_fiber_length != after.muscle(m.name).optimal_fiber_length}
+    assert changed == {"soleus_r"} and after.muscle("soleus_r").optimal_fiber_length == 0.0451
+
+
 def test_scaled_body_is_read_by_opensim_as_nmsm_scales_it(shared_data: Path, tmp_path: Path, bridge) -> None:
     from nmsm.model import CasadiModel, ModelParameters
 
