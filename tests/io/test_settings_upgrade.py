@@ -121,6 +121,23 @@ def test_toy_arm_treatment_mapping(shared_data: Path) -> None:
 
 
 @pytest.mark.shared_data
+def test_old_ncp_moment_term_is_renamed(shared_data: Path) -> None:
+    """The early-2023 NCP file names its ID moment term ``inverse_dynamics_joint_moment`` (MTP's
+    name; ``newNCPSettingsFile.xml`` has the same 5 N m term as ``moment_tracking``): kept as it
+    was, ``nmsm run`` refused it as a cost not allowed in NCP."""
+    from nmsm.core.registry import get_registry
+
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        ncp = read_tool_settings(shared_data / "ncp/patient3_bilateral_trials1to3/oldNCPSettingsFile.xml")
+    assert [c.type for c in ncp.cost_terms] == ["moment_tracking", "activation_tracking", "activation_minimization"]
+    assert ncp.cost_terms[0].fields["max_allowable_error"] == "5"
+    assert any("inverse_dynamics_joint_moment renamed moment_tracking" in str(w.message) for w in record)
+    for term in ncp.cost_terms:
+        get_registry().get("cost", term.type, "NCP")  # raises for a cost NCP does not accept
+
+
+@pytest.mark.shared_data
 def test_personalization_mappings(shared_data: Path) -> None:
     jmp = _quiet(read_tool_settings, shared_data / "jmp/gait2392_walk_free/JMPSettings.xml")
     (task,) = jmp.tasks

@@ -44,6 +44,10 @@ NCP_TERMS = {
     "GroupedActivation": "grouped_activations",
     "GroupedNormalizedMuscleFiberLength": "grouped_fiber_lengths",
 }
+#: old NCP ``<RCNLCostTerm><type>`` values -> current: the early-2023 NCP named its ID joint-moment
+#: tracking term as MTP does (``oldNCPSettingsFile.xml``; ``newNCPSettingsFile.xml`` has the same
+#: term, 5 N m, as ``moment_tracking``)
+NCP_TERM_TYPES = {"inverse_dynamics_joint_moment": "moment_tracking"}
 
 
 def upgrade(up: Upgrader) -> None:
@@ -177,10 +181,24 @@ def _ncp(up: Upgrader, tool: etree._Element) -> None:
     if old_terms is not None:
         term_set = _blocks_to_terms(up, old_terms, NCP_TERMS)
         tool.replace(old_terms, term_set)
+    _rename_term_types(up, tool, NCP_TERM_TYPES)
     init = child_of(tool, "muscle_tendon_parameter_initialization")
     if init is not None:
         up.drop(init, "superseded by <MuscleTendonLengthInitialization><is_enabled>")
     _muscle_common(up, tool)
+
+
+def _rename_term_types(up: Upgrader, tool: etree._Element, mapping: dict[str, str]) -> None:
+    """``<RCNLCostTerm><type>`` values of an already term-shaped old file -> current names."""
+    term_set = child_of(tool, "RCNLCostTermSet")
+    if term_set is None:
+        return
+    for term in elements(term_set):
+        type_element = child_of(term, "type") if term.tag == "RCNLCostTerm" else None
+        old = (type_element.text or "").strip() if type_element is not None else ""
+        if old in mapping:
+            type_element.text = mapping[old]
+            up.note(type_element, f"cost <type> {old} renamed {mapping[old]}")
 
 
 def _muscle_common(up: Upgrader, tool: etree._Element) -> None:
