@@ -10,8 +10,8 @@ Usage: ``python benchmarks/bench_mtp.py [v3] [v1] [patient3]``.
 
 from __future__ import annotations
 
+import argparse
 import os
-import sys
 import tempfile
 import time
 import warnings
@@ -48,4 +48,6 @@ def main(names: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["v3", "v1", "patient3"])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("cases", nargs="*", choices=list(CASES), help="cases to time (default: all)")
+    main(parser.parse_args().cases or list(CASES))

@@ -8,8 +8,8 @@ bounds, wall time). Usage: ``python benchmarks/mtp_tutorial_table.py [V1 V2 V3]`
 
 from __future__ import annotations
 
+import argparse
 import os
-import sys
 import tempfile
 import time
 import warnings
@@ -57,4 +57,7 @@ def main(versions: list[str]) -> str:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["V1", "V2", "V3"])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("versions", nargs="*", choices=["V1", "V2", "V3"],
+                        help="tutorial settings versions (default: all three)")
+    main(parser.parse_args().versions or ["V1", "V2", "V3"])
