@@ -136,7 +136,8 @@ def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metric
         "moment RMS (N m) per coordinate:",
         *[f"  {c:<40s} {v:.4f}" for c, v in zip(metrics.coordinates, metrics.moment_rms)],
         f"  mean over coordinates                    {metrics.mean_moment_rms:.4f}",
-        f"activation RMS vs MTP (pooled): {metrics.activation_rms_pooled:.5f}; VAF {100 * metrics.activation_vaf:.2f} %",
+        (f"activation RMS vs MTP (pooled): {metrics.activation_rms_pooled:.5f}; VAF {100 * metrics.activation_vaf:.2f} %"
+         if inputs.mtp_muscles else "activation RMS vs MTP: none (no muscle has MTP activations)"),
         f"wall time {wall:.1f} s",
     ]
     if setup.mtli_muscles:
