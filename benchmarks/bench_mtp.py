@@ -49,5 +49,8 @@ def main(names: list[str]) -> None:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("cases", nargs="*", choices=list(CASES), help="cases to time (default: all)")
-    main(parser.parse_args().cases or list(CASES))
+    parser.add_argument("cases", nargs="*", metavar="CASE", help=f"cases to time, of {', '.join(CASES)} (default: all)")
+    cases = parser.parse_args().cases or list(CASES)
+    if unknown := [c for c in cases if c not in CASES]:
+        parser.error(f"unknown case {', '.join(unknown)} (choose from {', '.join(CASES)})")
+    main(cases)

@@ -58,6 +58,9 @@ def main(versions: list[str]) -> str:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("versions", nargs="*", choices=["V1", "V2", "V3"],
-                        help="tutorial settings versions (default: all three)")
-    main(parser.parse_args().versions or ["V1", "V2", "V3"])
+    parser.add_argument("versions", nargs="*", metavar="VERSION",
+                        help="tutorial settings versions, of V1, V2, V3 (default: all three)")
+    versions = parser.parse_args().versions or ["V1", "V2", "V3"]
+    if unknown := [v for v in versions if v not in ("V1", "V2", "V3")]:
+        parser.error(f"unknown version {', '.join(unknown)} (choose from V1, V2, V3)")
+    main(versions)
