@@ -45,6 +45,13 @@ def run_settings_file(settings_file: str | Path, **options: Any) -> Any:
     tag = tool_element_name(settings_file)
     target = TOOL_RUNNERS.get(tag)
     if target is None:
+        if tag == "OptimalControlSolverSettings":
+            raise InputError(
+                "<OptimalControlSolverSettings> is the solver settings of a treatment optimization, not a tool to run",
+                file=settings_file,
+                expected="a Tracking, Verification or Design Optimization settings file naming this file in its "
+                "<optimal_control_solver_settings_file>: run that file",
+            )
         raise InputError(
             f"unknown tool element <{tag}>",
             file=settings_file,

@@ -172,6 +172,34 @@ def test_unknown_root_and_two_tools(tmp_path: Path) -> None:
         read_settings_document(_write(tmp_path, two))
 
 
+@pytest.mark.parametrize("relative,tool,hint", [
+    ("jmp/uf_subject3_tutorial/IKSettingsFiles/IKSettingsHips.xml", "InverseKinematicsTool", "'nmsm ik MODEL --ik-settings FILE'"),
+    ("preprocessing/uf_subject3_tutorial/input_data/IDSettings.xml", "InverseDynamicsTool", "'nmsm id MODEL MOTION"),
+    ("preprocessing/uf_subject3_tutorial/input_data/MASettings.xml", "AnalyzeTool", "'nmsm muscle-analysis MODEL MOTION"),
+    ("moco2d/referenceGRF.xml", "ExternalLoads", "as --external-loads"),
+    ("jmp/uf_subject3_tutorial/ScaleSettings.xml", "ScaleTool", "nmsm has no scaling tool"),
+])
+def test_opensim_tool_file_given_to_run(shared_data: Path, relative: str, tool: str, hint: str) -> None:
+    """An OpenSim tool's own settings (the tutorials ship IK/ID/Analyze/Scale files and external
+    loads next to NMSM's) is named as such, with the nmsm command that reads it."""
+    from nmsm.tools.dispatch import run_settings_file
+
+    with pytest.raises(InputError) as info:
+        run_settings_file(shared_data / relative)
+    assert info.value.element == f"<{tool}>" and info.value.file == str(shared_data / relative)
+    assert f"<OpenSimDocument> holding <{tool}>: an OpenSim file" in info.value.detail
+    assert hint in info.value.expected
+
+
+def test_solver_settings_given_to_run(shared_data: Path) -> None:
+    from nmsm.tools.dispatch import run_settings_file
+
+    path = shared_data / "treatment/synergy_kick_tutorial/gpopsSettings.xml"
+    with pytest.raises(InputError, match="solver settings of a treatment optimization") as info:
+        run_settings_file(path)
+    assert "<optimal_control_solver_settings_file>" in info.value.expected
+
+
 def test_version_major_error_minor_warning(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="version 2.0.0 is not supported"):
         read_settings_document(_write(tmp_path, DOC.replace('Version="1.5.0"', 'Version="2.0.0"')))

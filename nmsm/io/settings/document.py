@@ -431,6 +431,17 @@ def check_version(root: etree._Element, path: Path) -> str:
     return str(text)
 
 
+#: OpenSim tool settings (``<OpenSimDocument>``) that 'nmsm run' is given by mistake -> where they belong
+OPENSIM_TOOL_FILES = {
+    "InverseKinematicsTool": "an OpenSim IK settings file is read by 'nmsm ik MODEL --ik-settings FILE' "
+    "and 'nmsm preprocess --ik-settings FILE'",
+    "InverseDynamicsTool": "for inverse dynamics run 'nmsm id MODEL MOTION --external-loads LOADS.xml -o OUT.sto'",
+    "AnalyzeTool": "for a muscle analysis run 'nmsm muscle-analysis MODEL MOTION -o MAData'",
+    "ExternalLoads": "an ExternalLoads file is given to 'nmsm id' and 'nmsm preprocess' as --external-loads",
+    "ScaleTool": "nmsm has no scaling tool: scale the model in OpenSim",
+}
+
+
 def read_settings_document(
     path: str | os.PathLike[str], *, check_paths: bool = True, upgrade: bool = True
 ) -> SettingsDocument:
@@ -465,6 +476,17 @@ def read_settings_document(
         root = result.root
         upgraded_from = schema
     if root.tag != ROOT:
+        inner = next(iter(elements(root)), None)
+        use = OPENSIM_TOOL_FILES.get(str(inner.tag)) if root.tag == "OpenSimDocument" and inner is not None else None
+        if use is not None:
+            raise InputError(
+                f"root element is <{root.tag}> holding <{inner.tag}>: an OpenSim file, "
+                "not the settings of an NMSM tool that 'nmsm run' runs",
+                file=path,
+                line=inner.sourceline,
+                element=f"<{inner.tag}>",
+                expected=f"<{ROOT}> (an NMSM settings file); {use}",
+            )
         raise InputError(
             f"root element is <{root.tag}>",
             file=path,
