@@ -8,8 +8,10 @@ For each frame ``k`` the free coordinates ``q`` (see
 within the ranges of clamped coordinates, as OpenSim's InverseKinematicsSolver does with
 ``constraint_weight = Inf``: locked coordinates stay at their default values, coupled
 coordinates follow their couplers, a marker missing in a frame (NaN) is dropped from that
-frame. The first frame starts from the model's default pose (as OpenSim's ``assemble``),
-every later frame from the previous solution. Each frame is a small bound-constrained
+frame. The first frame starts from the model's default pose (as OpenSim's ``assemble``)
+and, when a clamped coordinate's default sits on a bound of its range, also from that pose
+with such coordinates at mid-range; the lower cost wins (:func:`first_frame_starts`). Every
+later frame starts from the previous solution. Each frame is a small bound-constrained
 Levenberg-Marquardt solve (:mod:`~nmsm.tools.jmp.levenberg_marquardt`) on a CasADi SX
 function giving residuals and their exact Jacobian.
 
@@ -211,6 +213,7 @@ def inverse_kinematics(
     iterations = np.zeros(n_frames, dtype=int)
     converged = np.zeros(n_frames, dtype=bool)
     start = time.perf_counter()
+    starts = first_frame_starts(q0, kin.lower, kin.upper) if initial is None else [q0]
     q = q0
     for k in range(n_frames):
         args = (p, x_exp[k], sqrt_w[k], c_targets[k])
@@ -219,7 +222,11 @@ def inverse_kinematics(
             r, jac = frame(x, *args)
             return r.ravel(), DenseJacobian(jac)
 
-        result = solve(fun, q, kin.lower, kin.upper, tol)
+        if k == 0:
+            tried = [solve(fun, start, kin.lower, kin.upper, tol) for start in starts]
+            result = min(tried, key=lambda r: r.cost)  # the default pose's on a tie
+        else:
+            result = solve(fun, q, kin.lower, kin.upper, tol)
         q = result.x
         q_free[k] = q
         iterations[k] = result.iterations
@@ -238,6 +245,25 @@ def inverse_kinematics(
         rotational=frozenset(c.name for c in model.coordinates if c.motion_type == "rotational"),
         iterations=iterations, converged=converged, wall_time=wall, unit_factor=factor,
     )
+
+
+def first_frame_starts(q0: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> list[np.ndarray]:
+    """Starting points ``(n_free,)`` of the first frame: the default pose ``q0`` and, when some
+    bounded coordinate sits on a bound of its range there, the same pose with those coordinates
+    at the middle of their range.
+
+    A default on a bound (elbows and knees at 0 in [0, 150 deg]) is where a bound-constrained
+    step cannot leave the bound while the markers' pull points outward: the first frame of a
+    trial with bent arms then ends with the elbows at 0 and the arms rotated instead (48.8 mm
+    RMS against OpenSim's 12.7 mm on the subject-3 tutorial's hips trial); every later frame
+    starts there and stays."""
+    bounded = np.isfinite(lower) & np.isfinite(upper)
+    on_bound = bounded & ((q0 <= lower) | (q0 >= upper))
+    if not on_bound.any():
+        return [q0]
+    moved = q0.copy()
+    moved[on_bound] = 0.5 * (lower[on_bound] + upper[on_bound])
+    return [q0, moved]
 
 
 def _frame_function(kin: MarkerKinematics, coordinate_names: Sequence[str], coordinate_weights: np.ndarray) -> cs.Function:
