@@ -184,10 +184,17 @@ def inverse_dynamics_of_motion(
     if other:
         warnings.warn(f"{model.file}: force elements not modeled by nmsm are left out of inverse dynamics: "
                       + ", ".join(f"{f.type} '{f.name}'" for f in other), stacklevel=2)
-    include_contact = any(f.applies_force for f in model.contact_forces)
+    contact = [f for f in model.contact_forces if f.applies_force]
+    include_contact = bool(contact)
     columns = [q.T, qd.T, qdd.T]
     bodies: Sequence[str] = ()
     if external_loads is not None and external_loads.forces:
+        if contact:
+            names = ", ".join(f.name for f in contact[:4]) + (f" and {len(contact) - 4} more" if len(contact) > 4 else "")
+            warnings.warn(f"{model.file}: the model's contact forces (SmoothSphereHalfSpaceForce {names}) act in "
+                          f"inverse dynamics together with the external loads of {external_loads.source}; if "
+                          "these are the measured ground reactions, the feet are loaded twice: set the contact "
+                          "forces' <appliesForce> to false in a copy of the model to leave them out", stacklevel=2)
         sampled = sample_loads(external_loads, out_times, load_table)
         bodies = tuple(s.spec.body for s in sampled)
         for body in bodies:

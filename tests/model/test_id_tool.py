@@ -130,3 +130,20 @@ def test_loads_expressed_in_body_frames_match_opensim(shared_data: Path, bridge,
     reference = read_storage(out)
     ours = inverse_dynamics_of_motion(load_model(model_path), read_storage(motion), external_loads=loads, lowpass_hz=6.0)
     assert np.abs(ours.data - reference.data).max() <= 1e-6
+
+
+def test_contact_forces_with_external_loads_warn(shared_data: Path) -> None:
+    """The 2D Moco model's smooth-sphere contacts plus its measured ground reactions: both act,
+    so the feet are loaded twice — said, not silently summed."""
+    folder = shared_data / "moco2d"
+    model = load_model(folder / "2D_gait.osim")
+    motion = read_storage(folder / "referenceCoordinates.sto")
+    loads = read_external_loads(folder / "referenceGRF.xml")
+    with pytest.warns(UserWarning, match=r"contact forces \(SmoothSphereHalfSpaceForce contactHeel_r, contactHeel_l, contactFront_r, "
+                                         r"contactFront_l\).*loaded twice.*appliesForce"):
+        inverse_dynamics_of_motion(model, motion, external_loads=loads)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        inverse_dynamics_of_motion(model, motion)  # contact alone: nothing to say
