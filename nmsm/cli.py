@@ -8,10 +8,12 @@ the parsed ``argparse.Namespace`` and returning an exit code.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from typing import Any
 
 from nmsm import __version__
 from nmsm.cli_types import non_negative_float
@@ -98,6 +100,27 @@ def _misplaced_global_option(parser: argparse.ArgumentParser, argv: Sequence[str
     return None
 
 
+@contextlib.contextmanager
+def each_warning_once() -> Iterator[None]:
+    """Show each warning text once while a command runs: a file read by several steps (the
+    preprocessing reads its IK file for IK checks, ID and the muscle analysis) warns from
+    several places, which Python's "default" filter would all show."""
+    shown: set[str] = set()
+    show = warnings.showwarning
+
+    def show_once(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: Any = None, line: str | None = None) -> None:
+        if str(message) not in shown:
+            shown.add(str(message))
+            show(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show_once
+    try:
+        yield
+    finally:
+        warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -111,7 +134,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     warnings.simplefilter("default")
     warnings.formatwarning = lambda msg, cat, *a, **k: f"warning: {msg}\n"
     try:
-        with progress_every(args.progress):
+        with progress_every(args.progress), each_warning_once():
             return int(args.func(args) or 0)
     except NmsmError as exc:
         if args.traceback:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from nmsm import __version__
-from nmsm.cli import build_parser
+from nmsm.cli import build_parser, main
 
 
 def test_python_dash_m_runs_the_command_line():
@@ -55,3 +55,17 @@ def test_every_runner_of_nmsm_run_says_where_its_results_are():
         if returned is not Path:
             assert inspect.isclass(returned) and attrs.has(returned), tag
             assert "results_directory" in attrs.fields_dict(returned), tag
+
+
+def test_a_warning_is_shown_once_per_command(shared_data, tmp_path, recwarn):
+    """Preprocessing reads its IK file in several steps (checks, ID, muscle analysis), each of
+    which warns about the file's repeated row: the command shows that text once."""
+    folder = shared_data / "opensim_gait10dof18musc"
+    code = main(["preprocess", "--time-pair", "0.6 1.0", "--output", str(tmp_path / "out"), "--cutoff", "0",
+                 "--model", str(folder / "gait10dof18musc_subject01.osim"),
+                 "--ik", str(folder / "gait10dof18musc_subject_adjusted_Kinematics_q.sto"),
+                 "--external-loads", str(folder / "gait10dof18musc_subject01_walk_grf.xml"),
+                 "--compute-muscle-analysis"])
+    assert code == 0
+    repeated = [w for w in recwarn if "repeat the previous row" in str(w.message)]
+    assert len(repeated) == 1
