@@ -40,6 +40,7 @@ from typing import Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import ModelError
 from nmsm.model.components import GROUND, CoordinateActuator, Model, PointActuator, TorqueActuator
@@ -130,7 +131,7 @@ class CasadiModel:
 
         def build() -> cs.Function:
             st = self._position_states()[body] if body != GROUND else BodyState(cs.DM.eye(3), cs.DM.zeros(3, 1))
-            return cs.Function(f"pose_{body}", self._inputs(self.q), [st.R, st.p],
+            return cs.Function(function_name("pose", body), self._inputs(self.q), [st.R, st.p],
                                self._input_names("q"), ["R", "origin"])
 
         return self._function(("pose", body), build)
@@ -148,7 +149,7 @@ class CasadiModel:
             x = cs.SX.sym("x_local", 3)
             st = self._position_states()[body] if body != GROUND else BodyState(cs.DM.eye(3), cs.DM.zeros(3, 1))
             scaled = x * self.kinematics.scale(body) if body != GROUND else x
-            return cs.Function(f"point_{body}", self._inputs(self.q, x), [st.p + cs.mtimes(st.R, scaled)],
+            return cs.Function(function_name("point", body), self._inputs(self.q, x), [st.p + cs.mtimes(st.R, scaled)],
                                self._input_names("q", "x_local"), ["x"])
 
         return self._function(("point", body), build)
@@ -219,7 +220,7 @@ class CasadiModel:
 
         def build() -> cs.Function:
             st = self._position_states()[body]
-            return cs.Function(f"angles_{body}", self._inputs(self.q), [body_xyz_angles(st.R)],
+            return cs.Function(function_name("angles", body), self._inputs(self.q), [body_xyz_angles(st.R)],
                                self._input_names("q"), ["angles"])
 
         return self._function(("angles", body), build)
@@ -249,7 +250,7 @@ class CasadiModel:
             x = cs.SX.sym("x_local", 3)
             st = self.kinematics.forward(self.q, self.qdot)[body]
             r = cs.mtimes(st.R, x * self.kinematics.scale(body))
-            return cs.Function(f"velocity_{body}", self._inputs(self.q, self.qdot, x), [st.v + cs.cross(st.w, r)],
+            return cs.Function(function_name("velocity", body), self._inputs(self.q, self.qdot, x), [st.v + cs.cross(st.w, r)],
                                self._input_names("q", "qdot", "x_local"), ["v"])
 
         return self._function(("velocity", body), build)

@@ -24,6 +24,7 @@ from __future__ import annotations
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.errors import ModelError
 from nmsm.model.components import Joint
 from nmsm.model.functions import LinearFunction, value_and_derivatives
@@ -203,6 +204,6 @@ def joint_motion_function(joint: Joint, custom_joint_bias: str = "opensim") -> c
         c_w = cs.SX.zeros(3, 1)
         c_v = cs.SX.zeros(3, 1)
     return cs.Function(
-        f"motion_{joint.name}", [q, u, s], [rotation, translation, h_w, h_v, c_w, c_v],
+        function_name("motion", joint.name), [q, u, s], [rotation, translation, h_w, h_v, c_w, c_v],
         ["q", "u", "s"], ["R", "p", "H_w", "H_v", "c_w", "c_v"], {"cse": True},
     )

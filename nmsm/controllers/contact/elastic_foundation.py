@@ -16,6 +16,7 @@ from typing import Any, ClassVar
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.core.plugin_bases import ContactModel
 from nmsm.model.foot_contact import CONTACT_PARAMETERS, ContactSurfaceModel, contact_function, spring_forces
 
@@ -89,7 +90,7 @@ class ElasticFoundationContact(ContactModel):
             columns.append(cs.vertcat(total, origin, torque))
         point = cs.vertcat(marker[0], p[CONTACT_PARAMETERS.index("resting_spring_length")], marker[2])
         inputs = cs.vertcat(p, *geometry)
-        return cs.Function(f"contact_{self.name}", [q, qd, inputs], [cs.horzcat(*columns), force, moment, point])
+        return cs.Function(function_name("contact", self.name), [q, qd, inputs], [cs.horzcat(*columns), force, moment, point])
 
     def spring_count(self) -> int:
         return int(np.size(self.surface.spring_constants))

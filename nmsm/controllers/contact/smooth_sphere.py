@@ -32,6 +32,7 @@ from typing import Any, ClassVar
 
 import casadi as cs
 
+from nmsm.core.function_names import function_name
 from nmsm.core.plugin_bases import ContactModel
 
 #: sides of OpenSim's gait ground-reaction convention
@@ -135,4 +136,4 @@ class SmoothSphereContact(ContactModel):
             point = weighted / (weight + 1e-6)
         on_ground = cs.vertcat(point[0], 0, point[2])
         about_point = moment - cs.cross(on_ground, total)
-        return cs.Function(f"contact_{self.name}", [q, qd, p], [loads, total, about_point, on_ground])
+        return cs.Function(function_name("contact", self.name), [q, qd, p], [loads, total, about_point, on_ground])

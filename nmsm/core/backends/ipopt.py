@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import interrupt_after_solve
 from nmsm.core.problem import Solution
 from nmsm.core.progress import SolveProgress, solve_progress
@@ -83,7 +84,7 @@ def solve_ipopt(
     if progress is not None:  # IPOPT silent: a progress line every few seconds instead
         opts["iteration_callback"] = _ProgressCallback(progress, xs.numel(), g.numel(), ps.numel(), lbg, ubg)
     opts.update(casadi_options or {})
-    solver = cs.nlpsol(problem.name.replace(" ", "_") or "nlp", "ipopt", nlp, opts)
+    solver = cs.nlpsol(function_name(problem.name or "nlp"), "ipopt", nlp, opts)
     lo, hi = problem.bounds_scaled()
     x0 = problem.initial_scaled() if initial_guess is None else np.asarray(initial_guess, dtype=float)
     x0 = np.clip(x0, lo, hi)

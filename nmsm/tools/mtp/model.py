@@ -32,6 +32,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.model import hill
 from nmsm.tools.mtp import emg_spline
 from nmsm.tools.mtp.data import TrialData
@@ -148,7 +149,7 @@ class TrialChain:
         neural = hill.clip_negative(neural_all[pad : pad + n], self.clip_smoothing)
         act = hill.activation_nonlinearity(neural, nonlin)
         activation = cs.Function(
-            f"mtp_activation_{self.trial.name}",
+            function_name("mtp_activation", self.trial.name),
             [delay, tau, nonlin, coefs],
             [e, neural, act],
             ["delay", "tau", "A", "coefs"],
@@ -160,7 +161,7 @@ class TrialChain:
         alpha = cs.SX.sym("alpha")
         f0 = cs.SX.sym("F0")
         force = cs.Function(
-            f"mtp_force_{self.trial.name}",
+            function_name("mtp_force", self.trial.name),
             [a, lnorm, vnorm, f0, alpha],
             [hill.tendon_force(a, lnorm, vnorm, f0, alpha)],
             ["a", "l", "v", "F0", "alpha"],

@@ -16,6 +16,7 @@ from functools import cached_property
 
 import casadi as cs
 
+from nmsm.core.function_names import function_name
 from nmsm.model import CasadiModel, Model, load_model
 from nmsm.model.parameters import ModelParameters
 
@@ -81,9 +82,9 @@ class OsimTreatmentModel:
     def body_rotation_function(self, body: str) -> cs.Function:
         pose = self.casadi.body_pose_function(body)
         inputs = [cs.SX.sym("q", len(self.coordinate_names)), *self._parameter_inputs()]
-        return cs.Function(f"rotation_{body}", inputs, [pose(*inputs)[0]])
+        return cs.Function(function_name("rotation", body), inputs, [pose(*inputs)[0]])
 
     def body_origin_function(self, body: str) -> cs.Function:
         pose = self.casadi.body_pose_function(body)
         inputs = [cs.SX.sym("q", len(self.coordinate_names)), *self._parameter_inputs()]
-        return cs.Function(f"origin_{body}", inputs, [pose(*inputs)[1]])
+        return cs.Function(function_name("origin", body), inputs, [pose(*inputs)[1]])

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
 from nmsm.tools.treatment.context import GridView
 from nmsm.tools.treatment.orientation import euler_angles
 from nmsm.tools.treatment.transcription.base import Trajectory, map_rows
@@ -203,7 +204,7 @@ class ContextQuantities:
             used = [args[k.strip()] for k in uses.split(",")]
             extra = [cs.SX.sym(function.name_in(i), function.sparsity_in(i)) for i in range(len(used), function.n_in())]
             outs = function.call(used + extra)
-            return cs.Function(f"point_{function.name()}", [v, c, ratio, *extra], outs)
+            return cs.Function(function_name("point", function.name()), [v, c, ratio, *extra], outs)
         return self.cache(("composed", key), compute)
 
     def map_point(self, function: cs.Function, grid: str, *extra: Any) -> list[cs.MX]:
@@ -262,7 +263,7 @@ class ContextQuantities:
             q, qd = cs.SX.sym("q", nq), cs.SX.sym("qd", nq)
             p = cs.SX.sym("p", f.size1_in(2))
             _, force, moment, point = f(q, qd, p)
-            g = cs.Function(f"ground_reaction_{contact.name}", [q, qd, p], [force, moment, point])
+            g = cs.Function(function_name("ground_reaction", contact.name), [q, qd, p], [force, moment, point])
             composed = self.composed(("ground_reaction", id(contact)), g, "q, qd")
             force, moment, point = self.map_point(composed, grid, contact.parameters())
             return force, moment, point
@@ -342,7 +343,7 @@ class ContextQuantities:
             parameters = self.model_parameter_symbols()
             p = f(q, *parameters)
             v = cs.jtimes(p, q, qd)
-            return cs.Function(f"marker_{marker}", [q, qd, *parameters], [p, v])
+            return cs.Function(function_name("marker", marker), [q, qd, *parameters], [p, v])
         return self.cache(("marker_function", marker), compute)
 
     def marker(self, grid: str, marker: str) -> tuple[cs.MX, cs.MX]:
@@ -366,7 +367,7 @@ class ContextQuantities:
             q = cs.SX.sym("q", nq)
             parameters = self.model_parameter_symbols()
             R = self.data.model.body_rotation_function(body)(q, *parameters)
-            return cs.Function(f"orientation_{body}_{sequence}", [q, *parameters],
+            return cs.Function(function_name("orientation", body, sequence), [q, *parameters],
                                [cs.vertcat(*euler_angles(R, sequence))])
         return self.cache(("orientation_function", body, sequence), compute)
 

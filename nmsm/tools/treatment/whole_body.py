@@ -22,6 +22,8 @@ from typing import Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.function_names import function_name
+
 
 def _has_tree(model: Any) -> bool:
     return getattr(model, "casadi", None) is not None and hasattr(model.casadi, "kinematics")
@@ -107,4 +109,4 @@ def foot_reaction_function(contact_function: cs.Function, name: str = "foot", *,
         about_origin = cs.SX.zeros(3, 1)
         for k in range(loads.shape[1]):
             about_origin += cs.cross(loads[3:6, k], loads[0:3, k]) + loads[6:9, k]
-    return cs.Function(f"foot_reaction_{name}", [q, qd, p], [total, about_origin, floor_point])
+    return cs.Function(function_name("foot_reaction", name), [q, qd, p], [total, about_origin, floor_point])
