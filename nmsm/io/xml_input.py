@@ -50,3 +50,28 @@ def parse_xml_file(path: str | os.PathLike[str], *, what: str = "XML file",
         return etree.fromstring(data, etree.XMLParser(remove_blank_text=remove_blank_text))
     except etree.XMLSyntaxError as exc:
         raise xml_input_error(exc, path) from None
+
+
+def element_text(element: etree._Element | None) -> str:
+    """The stripped text directly inside ``element``, comments left out.
+
+    lxml's ``element.text`` stops at the first comment: ``<v_max_factor><!-- default 10 -->15
+    </v_max_factor>`` has ``text`` None (the ``15`` is the comment's tail), and
+    ``<coordinate_list>hip_flexion_r <!-- c --> knee_angle_r</coordinate_list>`` would lose
+    ``knee_angle_r``. The text is the element's own text plus the tails of its comments and
+    processing instructions, as XPath's ``string()`` reads a text-only element; the text of
+    child elements (and their tails) is not part of it.
+    """
+    if element is None:
+        return ""
+    parts = [element.text or ""]
+    parts.extend(child.tail or "" for child in element if not isinstance(child.tag, str))
+    return "".join(parts).strip()
+
+
+def set_element_text(element: etree._Element, text: str) -> None:
+    """Make ``text`` the whole text of ``element`` (comment tails emptied, comments kept)."""
+    element.text = text
+    for child in element:
+        if not isinstance(child.tag, str):
+            child.tail = None

@@ -31,7 +31,7 @@ from lxml import etree
 from nmsm.core.term import SourceRef, TermSpec
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
-from nmsm.io.xml_input import parse_xml_file
+from nmsm.io.xml_input import element_text, parse_xml_file
 
 #: the NMSM Pipeline version whose settings schema nmsm reads
 PIPELINE_VERSION = (1, 5, 3)
@@ -151,7 +151,7 @@ class SettingsDocument:
         return f" (found <{found.tag}> at line {found.sourceline}: did you mean <{name}>?)"
 
     def text_of(self, element: etree._Element | None) -> str:
-        return "" if element is None else (element.text or "").strip()
+        return element_text(element)
 
     def _present(self, parent: etree._Element, name: str, required: bool) -> etree._Element | None:
         element = self.child(parent, name)
@@ -323,7 +323,7 @@ class SettingsDocument:
                 raise self.error(
                     child, f"<{child.tag}> appears twice in one term", expected=f"one <{child.tag}> per term"
                 )
-            if len(child):
+            if any(isinstance(grandchild.tag, str) for grandchild in child):  # comments are allowed
                 raise self.error(child, f"<{child.tag}> has child elements", expected="a term field with text only")
             fields[str(child.tag)] = self.text_of(child)
             lines[str(child.tag)] = child.sourceline

@@ -34,6 +34,7 @@ from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import ROOT, check_version, elements, parse_settings_xml, to_bool
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS
 from nmsm.tools.pipeline.kinds import StageKind, kind_for_element
+from nmsm.io.xml_input import element_text
 from nmsm.tools.pipeline.stage_settings import StageSettings
 
 TOOL = "PipelineTool"
@@ -92,7 +93,7 @@ def _is_tool_schema(kind: StageKind) -> bool:
 
 
 def _text(element: etree._Element | None) -> str:
-    return "" if element is None else (element.text or "").strip()
+    return element_text(element)
 
 
 def read_pipeline(path: str | os.PathLike[str]) -> PipelineSpec:

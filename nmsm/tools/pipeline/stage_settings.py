@@ -31,6 +31,7 @@ from nmsm.errors import InputError
 from nmsm.io.paths import normalize_separators, resolve_path
 from nmsm.io.settings.document import PIPELINE_VERSION_TEXT, ROOT, elements
 from nmsm.io.settings.schema import Setting, settings_fields
+from nmsm.io.xml_input import element_text, set_element_text
 from nmsm.tools.pipeline.hashing import DigestCache, text_digest
 
 
@@ -148,7 +149,7 @@ class StageSettings:
         Relative text resolves as the tools resolve it; a path not found anywhere resolves
         to ``base / text`` unless ``must_exist`` (then the tool's own error is raised).
         """
-        text = "" if field.element is None else (field.element.text or "").strip()
+        text = element_text(field.element)
         if not text:
             if field.spec.empty_is_base:
                 return field.base if field.base is not None else self.origin.parent
@@ -174,14 +175,14 @@ class StageSettings:
         element = field.element
         if element is None:
             element = etree.SubElement(field.parent, field.spec.element)
-        element.text = str(Path(value).resolve())
+        set_element_text(element, str(Path(value).resolve()))
 
     def set_text(self, element_name: str, text: str) -> None:
         """Set a direct child of the tool element (created if absent)."""
         element = self.tool.find(element_name)
         if element is None:
             element = etree.SubElement(self.tool, element_name)
-        element.text = text
+        set_element_text(element, text)
 
     def absolutize(self) -> None:
         """Rewrite relative and empty "this folder" path elements as absolute paths."""
