@@ -68,8 +68,42 @@ def _columns(table: Table, labels: Sequence[str], what: str) -> np.ndarray:
     return table.columns(labels)
 
 
-def read_moment_arms(folder: Path, prefix: str, coordinates: Sequence[str], muscles: Sequence[str]) -> np.ndarray:
-    """Moment arms (n_frames, n_coordinates, n_muscles) from ``<prefix>_MomentArm_<coord>.sto`` files."""
+def check_same_times(reference: Table, other: Table, prefix: str, *, padding: int = 0) -> None:
+    """An :class:`InputError` unless ``other``'s rows ``padding .. padding + n`` lie at the times of
+    ``reference`` (the trial's ID file), within a quarter of its median sample interval.
+
+    MTP and NCP match the ID, muscle-analysis and EMG rows by position (as the original), so a
+    file of another time window (an EMG exported with an offset, a muscle analysis of other
+    frames) would silently pair values of different instants. Row counts are checked elsewhere.
+    """
+    n = reference.n_rows
+    if other.n_rows < padding + n or n == 0:
+        return
+    times = other.time[padding : padding + n]
+    step = float(np.median(np.diff(reference.time))) if n > 1 else 0.0
+    bad = np.flatnonzero(np.abs(times - reference.time) > 0.25 * step + 1e-9 * np.maximum(1.0, np.abs(reference.time)))
+    if not bad.size:
+        return
+    k = int(bad[0])
+    source = reference.source
+    ref_name = f"{source.parent.name}/{source.name}" if source is not None else "the ID file"
+    rows = f"row {padding + k + 1}" + (f" (ID row {k + 1}; {padding} padding rows before it)" if padding else "")
+    raise InputError(
+        f"trial '{prefix}': data {rows} is at {float(times[k])!r} s but {ref_name} is at "
+        f"{float(reference.time[k])!r} s (off by {float(times[k] - reference.time[k]):.6g} s)",
+        file=other.source,
+        element="column 'time'",
+        expected=f"the times of {ref_name}"
+        + (f", with {padding} EMG rows before and after them" if padding else "")
+        + ": IDData, MAData and EMGData rows are paired by position, so they must be sampled at the same frames",
+    )
+
+
+def read_moment_arms(
+    folder: Path, prefix: str, coordinates: Sequence[str], muscles: Sequence[str], *, reference: Table | None = None
+) -> np.ndarray:
+    """Moment arms (n_frames, n_coordinates, n_muscles) from ``<prefix>_MomentArm_<coord>.sto`` files;
+    ``reference``: the trial's ID table, whose times each file's rows must have."""
     arms = []
     for coordinate in coordinates:
         try:
@@ -81,7 +115,10 @@ def read_moment_arms(folder: Path, prefix: str, coordinates: Sequence[str], musc
                 element=f"{prefix}_MomentArm_{coordinate}.sto",
                 expected="a MuscleAnalysis moment-arm table for every coordinate in <coordinate_list>",
             ) from exc
-        arms.append(_columns(read_storage(path), muscles, f"moment-arm file for '{coordinate}'"))
+        table = read_storage(path)
+        arms.append(_columns(table, muscles, f"moment-arm file for '{coordinate}'"))
+        if reference is not None and table.n_rows == reference.n_rows:
+            check_same_times(reference, table, prefix)
     return np.stack(arms, axis=1)
 
 
@@ -123,7 +160,7 @@ def load_trial(
     velocity = read_storage(find_file_by_suffix(folder, "_Velocity"))
     lmt = _columns(length, muscles, "muscle-tendon length file")
     vmt = _columns(velocity, muscles, "muscle-tendon velocity file")
-    arms = read_moment_arms(folder, prefix, coordinates, muscles)
+    arms = read_moment_arms(folder, prefix, coordinates, muscles, reference=id_table)
     n = id_table.n_rows
     for name, arr, src in (("length", lmt, length.source), ("velocity", vmt, velocity.source)):
         if arr.shape[0] != n:
@@ -134,6 +171,8 @@ def load_trial(
             )
     if arms.shape[0] != n:
         raise InputError(f"trial '{prefix}': moment arms have {arms.shape[0]} rows but ID has {n}", file=folder)
+    check_same_times(id_table, length, prefix)
+    check_same_times(id_table, velocity, prefix)
     emg_time = emg = None
     padding = 0
     if emg_channels is not None:
@@ -143,6 +182,7 @@ def load_trial(
         emg = _columns(emg_table, emg_channels, "EMG file")
         emg_time = emg_table.time
         padding = emg_padding(emg_table.n_rows, n, emg_path)
+        check_same_times(id_table, emg_table, prefix, padding=padding)
     return TrialData(
         name=prefix,
         time=id_table.time,

@@ -25,7 +25,7 @@ from nmsm.core.term import CostTerm
 from nmsm.errors import InputError
 from nmsm.io.storage import read_storage
 from nmsm.io.trials import find_file_by_suffix, find_trial_file, find_trial_folder
-from nmsm.tools.mtp.data import find_prefixes, read_moment_arms
+from nmsm.tools.mtp.data import check_same_times, find_prefixes, read_moment_arms
 from nmsm.tools.mtp.derivatives import gauss_newton_hessian
 from nmsm.tools.mtp.mtli_model import MtliContext, PassiveTrial, max_length_variable_index, mtli_quantities
 from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters
@@ -81,13 +81,14 @@ def load_passive_trials(
                 expected="a column per muscle crossing <coordinate_list>",
             )
         lmt = length.columns(muscles)
-        arms = read_moment_arms(folder, prefix, coordinates, muscles)
+        arms = read_moment_arms(folder, prefix, coordinates, muscles, reference=table)
         if not (lmt.shape[0] == arms.shape[0] == moments.shape[0]):
             raise InputError(
                 f"passive trial '{prefix}': ID has {moments.shape[0]} rows, lengths {lmt.shape[0]}, moment arms {arms.shape[0]}",
                 file=folder,
                 expected="IDData and MAData sampled at the same frames",
             )
+        check_same_times(table, length, prefix)
         trials.append(PassiveTrial(prefix, table.time, lmt, arms, moments))
     return tuple(trials)
 

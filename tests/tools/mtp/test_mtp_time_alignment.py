@@ -1,0 +1,111 @@
+"""MTP pairs the rows of IDData, MAData and EMGData by position (as the original): a file of
+another time window is an error naming it, a constant offset of every file or a 1e-6 s jitter
+is not. (An EMG file shifted by 0.05 s used to give a result, its EMG paired with moments
+50 ms away.)"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from nmsm.errors import InputError
+from nmsm.io.storage import read_storage
+from nmsm.tools.mtp.mtli import load_passive_trials
+from nmsm.tools.mtp.run import run_settings
+
+
+def _settings(folder: Path, tutorial: Path) -> Path:
+    path = folder / "MTPSettings.xml"
+    path.write_text(f"""<NMSMPipelineDocument Version="1.5.0"><MuscleTendonPersonalizationTool>
+ <results_directory>results</results_directory>
+ <input_model_file>{tutorial / 'UF_Subject_3_reduced_muscles.osim'}</input_model_file>
+ <input_osimx_file/>
+ <data_directory>preprocessed</data_directory>
+ <coordinate_list>hip_flexion_r knee_angle_r ankle_angle_r</coordinate_list>
+ <activation_muscle_groups>HamslatActivationGroupR</activation_muscle_groups>
+ <normalized_fiber_length_muscle_groups/>
+ <missing_emg_channel_muscle_groups>HipFlexorsMissingEMGChannelGroup</missing_emg_channel_muscle_groups>
+ <collected_emg_channel_muscle_groups>GlutMaxLat RecFem BicFemLong BicFemShort VastMed GasMed Sol TibAnt</collected_emg_channel_muscle_groups>
+ <max_iterations>50</max_iterations>
+ <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
+ <MTPSynergyExtrapolation><is_enabled>false</is_enabled></MTPSynergyExtrapolation>
+ <MTPTaskList><MTPTask><is_enabled>true</is_enabled>
+  <muscle_specific_electromechanical_delays>true</muscle_specific_electromechanical_delays><RCNLCostTermSet>
+  <RCNLCostTerm><is_enabled>true</is_enabled><type>inverse_dynamics_joint_moment</type>
+   <max_allowable_error>2.5</max_allowable_error></RCNLCostTerm>
+  <RCNLCostTerm><is_enabled>true</is_enabled><type>emg_scale_factor</type>
+   <max_allowable_error>0.2</max_allowable_error><error_center>0.3</error_center></RCNLCostTerm>
+ </RCNLCostTermSet></MTPTask></MTPTaskList>
+</MuscleTendonPersonalizationTool></NMSMPipelineDocument>""")
+    return path
+
+
+def _shift_times(path: Path, change) -> None:
+    """Rewrite the time column of an OpenSim table with ``change(times)`` (text edit, rest untouched)."""
+    lines = path.read_text().splitlines()
+    end = next(i for i, line in enumerate(lines) if line.strip().lower() == "endheader") + 2
+    rows = [line.split("\t") for line in lines[end:] if line.strip()]
+    times = change(np.array([float(row[0]) for row in rows]))
+    lines[end:] = ["\t".join([repr(float(t)), *row[1:]]) for t, row in zip(times, rows)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.fixture
+def case(tmp_path, shared_data):
+    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
+    shutil.copytree(tutorial / "preprocessed", tmp_path / "preprocessed")
+    return tmp_path, tutorial
+
+
+def test_emg_of_another_time_window_is_an_error(case):
+    folder, tutorial = case
+    emg = folder / "preprocessed" / "EMGData" / "gait_1.sto"
+    _shift_times(emg, lambda t: t + 0.05)
+    with pytest.raises(InputError) as info:
+        run_settings(_settings(folder, tutorial))
+    message = str(info.value)
+    assert str(emg) in message and "column 'time'" in message
+    assert "data row 20 (ID row 1; 19 padding rows before it) is at 0.55 s but IDData/gait_1.sto is at 0.5 s" in message
+    assert not (folder / "results").exists()
+
+
+def test_muscle_analysis_of_other_frames_is_an_error(case):
+    folder, tutorial = case
+    velocity = folder / "preprocessed" / "MAData" / "gait_1" / "gait_1_Velocity.sto"
+    _shift_times(velocity, lambda t: t - t[0])  # the same frames exported from 0 s
+    with pytest.raises(InputError, match=r"gait_1_Velocity.sto: column 'time': trial 'gait_1': data row 1 is at 0.0 s"):
+        run_settings(_settings(folder, tutorial))
+    arm = folder / "preprocessed" / "MAData" / "gait_1" / "gait_1_MomentArm_knee_angle_r.sto"
+    _shift_times(velocity, lambda t: t + 0.5)  # back to the ID's times
+    _shift_times(arm, lambda t: t + 0.011)  # one frame late
+    with pytest.raises(InputError, match=r"gait_1_MomentArm_knee_angle_r.sto: column 'time'"):
+        run_settings(_settings(folder, tutorial))
+
+
+def test_offset_of_every_file_gives_the_same_result(case, tmp_path_factory, shared_data):
+    folder, tutorial = case
+    plain = tmp_path_factory.mktemp("plain")
+    shutil.copytree(tutorial / "preprocessed", plain / "preprocessed")
+    run_settings(_settings(plain, tutorial))
+    for path in (folder / "preprocessed").rglob("*.sto"):
+        if path.parent.name != "IKData":
+            _shift_times(path, lambda t: t + 10.0)
+    run_settings(_settings(folder, tutorial))
+    name = "muscleActivations/gait_1_muscleActivations.sto"
+    expected, got = read_storage(plain / "results" / name), read_storage(folder / "results" / name)
+    np.testing.assert_allclose(got.time, expected.time + 10.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.data, expected.data, rtol=0, atol=1e-9)
+
+
+def test_passive_trial_moment_arms_of_other_frames_are_an_error(tmp_path, shared_data):
+    source = shared_data / "mtp" / "uf_subject3_tutorial" / "passive_moment_data"
+    shutil.copytree(source, tmp_path / "passive")
+    muscles = ["soleus_r", "gasmed_r"]
+    assert len(load_passive_trials(tmp_path / "passive", ["ankle_angle_r"], muscles)) == 12
+    arm = tmp_path / "passive" / "MAData" / "Thelen_AnklePassive_02" / "Thelen_AnklePassive_02_MuscleAnalysis_MomentArm_ankle_angle_r.sto"
+    _shift_times(arm, lambda t: t + 0.2)
+    with pytest.raises(InputError, match="Thelen_AnklePassive_02_MuscleAnalysis_MomentArm_ankle_angle_r.sto: column 'time'"):
+        load_passive_trials(tmp_path / "passive", ["ankle_angle_r"], muscles)
