@@ -277,6 +277,7 @@ def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy
         if not tokens:
             continue
         if len(tokens) != width:
+            _raise_empty_cell(lines[i], header, source, i + 1)
             raise InputError(
                 f"row has {len(tokens)} values but there are {width} column labels",
                 file=source,
@@ -318,6 +319,30 @@ def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy
         source=source,
         label_line=label_line,
     )
+
+
+def _raise_empty_cell(line: str, header: list[str], source: Path | None, number: int) -> None:
+    """An empty cell of a tab-separated row (a gap left by a spreadsheet or an exporter) is
+    named by its column: splitting on white space alone would report the row's last
+    column as missing."""
+    if "\t" not in line:
+        return
+    cells = line.rstrip("\r\n").split("\t")
+    while len(cells) > len(header) and not cells[-1].strip():
+        cells.pop()  # trailing tabs
+    if len(cells) != len(header):
+        return
+    empty = [j for j, cell in enumerate(cells) if not cell.strip()]
+    if empty:
+        names = ", ".join(f"'{header[j]}'" for j in empty[:5]) + (" ..." if len(empty) > 5 else "")
+        raise InputError(
+            f"empty cell{'s' if len(empty) > 1 else ''} in column{'s' if len(empty) > 1 else ''} {names}",
+            file=source,
+            line=number,
+            element=f"column '{header[empty[0]]}'",
+            expected="a number in every cell (write NaN for a gap where it is allowed: the centre-of-pressure "
+            "columns of GRF files)",
+        )
 
 
 def _raise_bad_number(rows: list[list[str]], row_lines: list[int], header: list[str], source: Path | None) -> None:
