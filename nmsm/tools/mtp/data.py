@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -97,6 +98,52 @@ def check_same_times(reference: Table, other: Table, prefix: str, *, padding: in
         + (f", with {padding} EMG rows before and after them" if padding else "")
         + ": IDData, MAData and EMGData rows are paired by position, so they must be sampled at the same frames",
     )
+
+
+#: processed EMG below this is reported (real envelopes reach -7e-7 from filter round-off)
+EMG_NEGATIVE_REPORTED = -0.01
+#: an EMG sample interval above this (s) is reported as probably milliseconds
+EMG_LONGEST_STEP = 0.5
+
+
+def check_emg(table: Table, channels: Sequence[str]) -> None:
+    """Warnings for processed EMG a run would use without complaint but that is likely wrong:
+    a channel with the same value in every row (a dead or unplugged electrode: its muscles get
+    no excitation whatever their scale factor), values below -0.01 (an envelope is >= 0; the
+    excitations and the results would carry them). A sample interval above 0.5 s (times in
+    milliseconds: the activation dynamics would see 1000 times the real interval) is an
+    :class:`InputError`."""
+    where = table.source if table.source is not None else "EMG"
+    dead = [c for c in channels if np.ptp(table.column(c)) <= 1e-12 * max(1.0, float(np.abs(table.column(c)).max()))]
+    if dead:
+        warnings.warn(
+            f"{where}: EMG channel(s) {', '.join(dead)} have the same value in every row (a dead channel?): "
+            "their muscles get no excitation from them; list their groups in "
+            "<missing_emg_channel_muscle_groups> instead of <collected_emg_channel_muscle_groups> to have them "
+            "estimated, or fix the EMG",
+            stacklevel=3,
+        )
+    for c in channels:
+        values = table.column(c)
+        k = int(np.argmin(values))
+        if values[k] < EMG_NEGATIVE_REPORTED:
+            n_bad = int(np.count_nonzero(values < EMG_NEGATIVE_REPORTED))
+            warnings.warn(
+                f"{where}: column '{c}': processed EMG reaches {float(values[k]):.4g} at {float(table.time[k]):.6g} s "
+                f"({n_bad} row(s) below {EMG_NEGATIVE_REPORTED}); a rectified, normalized envelope is >= 0 and "
+                "negative values give negative excitations",
+                stacklevel=3,
+            )
+    if table.n_rows > 1:
+        step = float(np.median(np.diff(table.time)))
+        if step > EMG_LONGEST_STEP:
+            raise InputError(
+                f"the EMG sample interval is {step:.6g} s: are the times in milliseconds?",
+                file=table.source,
+                element="column 'time'",
+                expected=f"times in seconds, sampled at most {EMG_LONGEST_STEP} s apart (the activation dynamics "
+                "have time constants of about 0.015 s)",
+            )
 
 
 def read_moment_arms(
@@ -183,6 +230,7 @@ def load_trial(
         emg_time = emg_table.time
         padding = emg_padding(emg_table.n_rows, n, emg_path)
         check_same_times(id_table, emg_table, prefix, padding=padding)
+        check_emg(emg_table, emg_channels)
     return TrialData(
         name=prefix,
         time=id_table.time,

@@ -109,3 +109,46 @@ def test_passive_trial_moment_arms_of_other_frames_are_an_error(tmp_path, shared
     _shift_times(arm, lambda t: t + 0.2)
     with pytest.raises(InputError, match="Thelen_AnklePassive_02_MuscleAnalysis_MomentArm_ankle_angle_r.sto: column 'time'"):
         load_passive_trials(tmp_path / "passive", ["ankle_angle_r"], muscles)
+
+
+def test_times_in_milliseconds_are_an_error(case):
+    folder, tutorial = case
+    for path in (folder / "preprocessed").rglob("*.sto"):
+        _shift_times(path, lambda t: t * 1000.0)
+    with pytest.raises(InputError, match=r"EMGData/gait_1.sto: column 'time': the EMG sample interval is 11 s: "
+                                         r"are the times in milliseconds\?"):
+        run_settings(_settings(folder, tutorial))
+
+
+def _edit_column(path: Path, label: str, change) -> None:
+    lines = path.read_text().splitlines()
+    end = next(i for i, line in enumerate(lines) if line.strip().lower() == "endheader") + 1
+    j = lines[end].split("\t").index(label)
+    for i in range(end + 1, len(lines)):
+        cells = lines[i].split("\t")
+        cells[j] = repr(change(i - end - 1, float(cells[j])))
+        lines[i] = "\t".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_dead_and_negative_emg_channels_warn(case):
+    folder, tutorial = case
+    emg = folder / "preprocessed" / "EMGData" / "gait_1.sto"
+    _edit_column(emg, "GasMed", lambda i, v: 0.0)
+    _edit_column(emg, "TibAnt", lambda i, v: -0.25 if i == 40 else v)
+    with pytest.warns(UserWarning) as record:
+        run_settings(_settings(folder, tutorial))
+    messages = [str(w.message) for w in record]
+    assert any(f"{emg}: EMG channel(s) GasMed have the same value in every row" in m for m in messages)
+    assert any(f"{emg}: column 'TibAnt': processed EMG reaches -0.25 at 0.731 s (1 row(s) below -0.01)" in m
+               for m in messages)
+
+
+def test_tutorial_emg_is_silent(case):
+    import warnings
+
+    folder, tutorial = case
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        run_settings(_settings(folder, tutorial))
+    assert not [w for w in record if "EMG" in str(w.message) and "gait_1.sto" in str(w.message)]
