@@ -96,7 +96,7 @@ def check_same_times(reference: Table, other: Table, prefix: str, *, padding: in
         element="column 'time'",
         expected=f"the times of {ref_name}"
         + (f", with {padding} EMG rows before and after them" if padding else "")
-        + ": IDData, MAData and EMGData rows are paired by position, so they must be sampled at the same frames",
+        + ": its rows are paired with the ID file's by position, so they must be sampled at the same frames",
     )
 
 

@@ -26,17 +26,18 @@ from nmsm.core.term import Term, build_terms
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, check_muscles_in_model, read_osimx
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
-from nmsm.io.storage import read_storage
+from nmsm.io.storage import Table, read_storage
 from nmsm.io.trials import find_trial_file
 from nmsm.model import load_model
 from nmsm.model.components import Model
-from nmsm.tools.mtp.data import find_prefixes, load_trial
+from nmsm.tools.mtp.data import check_same_times, find_prefixes, load_trial
 from nmsm.tools.mtp.muscles import MuscleParameters, resolve_groups
 from nmsm.tools.ncp.inputs import NcpInputs, NcpTrial
 from nmsm.tools.ncp.muscle_set import muscles_crossing, synergy_groups
 from nmsm.tools.ncp.spline import DEFAULT_NODE_COUNT
 from nmsm.tools.ncp.symmetry import mirror_muscle_map
 from nmsm.tools.ncp.synergies import SynergyLayout
+from nmsm.tools.ncp.vaf import non_negative
 
 
 @attrs.frozen(eq=False)
@@ -157,12 +158,16 @@ def _osimx_file(settings: NeuralControlPersonalizationSettings) -> Path | None:
 
 
 def _mtp_activations(
-    directory: Path, prefixes: Sequence[str], muscles: Sequence[str], frames: Sequence[int]
+    directory: Path, prefixes: Sequence[str], muscles: Sequence[str], frames: Sequence[int],
+    id_times: Sequence[Table] | None = None,
 ) -> tuple[tuple[str, ...], list[np.ndarray], list[Path]]:
     """MTP activations of the NCP muscles present in every trial's file.
 
     A muscle present in one trial's file and absent from another's is an error naming the
-    file and column; so is a file whose row count differs from the trial's ID rows.
+    file and column; so is a file whose row count differs from the trial's ID rows, or whose
+    times differ from them (``id_times``: each trial's ID times; rows are paired by position).
+    Activations below -0.01 are an error, slightly negative ones are set to 0 (as ``nmsm vaf``:
+    :func:`nmsm.tools.ncp.vaf.non_negative`).
     """
     folder = directory / "muscleActivations"
     tables, files = [], []
@@ -188,7 +193,11 @@ def _mtp_activations(
                 file=table.source,
                 expected=f"{n} rows (MTP output of the same trial)",
             )
-    return tuple(union), [t.columns(union) for t in tables], files
+    for table, prefix, reference in zip(tables, prefixes, id_times or [None] * len(tables)):
+        if reference is not None:
+            check_same_times(reference, table, prefix)
+    arrays = [non_negative(t.columns(union), union, t.time, t.source, t.label_line) for t in tables]
+    return tuple(union), arrays, files
 
 
 def load_ncp(
@@ -240,7 +249,9 @@ def load_ncp(
     files = None
     if settings.mtp_results_directory is not None:
         mtp_muscles, arrays, paths = _mtp_activations(
-            Path(settings.mtp_results_directory), prefixes, muscles, [t.n_frames for t in raw]
+            Path(settings.mtp_results_directory), prefixes, muscles, [t.n_frames for t in raw],
+            [Table(time=t.time, labels=(), data=np.zeros((t.n_frames, 0)),
+                   source=find_trial_file(Path(settings.data_directory) / "IDData", t.name)) for t in raw],
         )
         mtp_data = list(arrays)
         files = tuple(paths)
