@@ -82,9 +82,11 @@ def _poly_fourier_design(time: np.ndarray, frequency: float, harmonics: int) -> 
 def _sample_rate(time: np.ndarray) -> float:
     """The original's sampling-rate estimate (Hz): from the first ten intervals, rounded
     to 10 Hz (fewer samples: from the first interval)."""
-    if len(time) > 10:
-        return round(1.0 / (time[10] - time[0])) * 10.0
-    return float(round(1.0 / (time[1] - time[0])))
+    rate = round(1.0 / (time[10] - time[0])) * 10.0 if len(time) > 10 else float(round(1.0 / (time[1] - time[0])))
+    if not rate > 0:
+        raise InputError(f"the sampling rate of frames {time[1] - time[0]:.6g} s apart rounds to 0 Hz",
+                         element="column 'time'", expected="times in seconds, sampled at 1 Hz or more")
+    return rate
 
 
 def nodes_for_cutoff(time: np.ndarray, curves: np.ndarray, cutoff_hz: float, degree: int = 4,

@@ -29,6 +29,8 @@ from nmsm.model.components import GROUND, Model
 TIME_MATCH_TOLERANCE = 5e-3
 #: largest relative deviation of the motion's frame intervals from their mean
 EVEN_SPACING_TOLERANCE = 1e-3
+#: longest frame interval (s) of the motion: more is taken for times in milliseconds
+LONGEST_FRAME_INTERVAL = 0.5
 #: frames whose force magnitude exceeds this fraction of the window's peak count as loaded
 LOADED_FRACTION = 0.05
 
@@ -81,6 +83,11 @@ def window_indices(time: np.ndarray, start: float, end: float, *, file: Path, el
                       stacklevel=3)
     steps = np.diff(time[idx])
     mean = float(steps.mean())
+    if mean > LONGEST_FRAME_INTERVAL:
+        raise InputError(f"motion frames in [{start}, {end}] s are {mean:.6g} s apart: are the times in milliseconds?",
+                         file=file, element="column 'time'",
+                         expected=f"times in seconds, frames at most {LONGEST_FRAME_INTERVAL} s apart (the kinematics "
+                         "filter and the contact model's velocities take the time column in seconds)")
     if np.abs(steps - mean).max() > EVEN_SPACING_TOLERANCE * mean:
         raise InputError(f"motion frames in [{start}, {end}] s are not evenly spaced "
                          f"(intervals {steps.min():.6g}..{steps.max():.6g} s)", file=file,
