@@ -10,7 +10,10 @@ tracked folder, the initial kinematics from the initial-guess folder (falling ba
 tracked ones). Times are shifted to start at 0 (each file's start is kept in
 ``TreatmentFiles.start_times``); IK degrees become radians for the model's rotational
 coordinates only. :func:`guess_time_problems` reports initial-guess files on other times than
-the tracked data.
+the tracked data. The tracked ID and GRF files must span the tracked IK's times (each is
+read from its own start, so one starting or ending elsewhere would be tracked shifted in
+time), and the tracked IK's frames must be at most 0.5 s apart (times in milliseconds):
+:class:`InputError` otherwise.
 """
 
 from __future__ import annotations
@@ -28,6 +31,9 @@ from nmsm.io.trials import find_trial_file
 from nmsm.tools.treatment.model_interface import TreatmentModel
 
 #: initial-guess files written by a previous TO/VO/DO: kind -> file suffix
+#: largest sample interval (s) of the tracked IK: more is taken for times in milliseconds
+LONGEST_SAMPLE_INTERVAL = 0.5
+
 RESULT_FILES = {
     "states": "_states",
     "accelerations": "_accelerations",
@@ -134,11 +140,38 @@ def read_treatment_files(tracked_dir: Path, initial_dir: Path, trial: str, model
     for name, table in (("tracked IK", tracked_ik), ("initial IK", initial_ik)):
         if table.n_rows < 2:
             raise InputError(f"{name} has {table.n_rows} row(s)", file=table.source, expected="at least 2 time rows")
+    _check_tracked_times(tracked_ik, (tracked_id, tracked_grf), starts)
     if tracked_id is None:
         warnings.warn(f"{tracked_dir}: no IDData/{trial}: terms and torque controls needing tracked loads will fail",
                       stacklevel=2)
     return TreatmentFiles(trial, tracked_ik, tracked_id, tracked_grf, initial_ik, initial_id, results, synergy_weights,
                           tracked_dir, initial_dir, starts)
+
+
+def _check_tracked_times(ik: Table, others: tuple[Table | None, ...], starts: dict[str, float]) -> None:
+    """The tracked IK's frames in seconds, and the tracked ID/GRF files over the same times
+    (within one IK sample interval; module docstring)."""
+    step = float(np.median(np.diff(ik.time)))
+    if step > LONGEST_SAMPLE_INTERVAL:
+        raise InputError(f"the tracked IK's frames are {step:.6g} s apart: are the times in milliseconds?",
+                         file=ik.source, element="column 'time'",
+                         expected=f"times in seconds, frames at most {LONGEST_SAMPLE_INTERVAL} s apart")
+    start = starts.get(str(ik.source), 0.0)
+    end = start + duration(ik)
+    for table in others:
+        if table is None:
+            continue
+        first = starts.get(str(table.source), 0.0)
+        last = first + duration(table)
+        if abs(first - start) > step + 1e-9 or abs(last - end) > step + 1e-9:
+            kind = table.source.parent.name if table.source is not None else "tracked"
+            raise InputError(
+                f"the tracked {kind} file covers {first:.6g}-{last:.6g} s but the tracked IK {ik.source} covers "
+                f"{start:.6g}-{end:.6g} s",
+                file=table.source, element="column 'time'",
+                expected=f"the tracked IK's times (within one sample interval, {step:.6g} s): each file is read from "
+                "its own start, so a file starting or ending elsewhere would be tracked shifted in time",
+            )
 
 
 def duration(table: Table) -> float:
