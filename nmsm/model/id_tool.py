@@ -35,6 +35,10 @@ from nmsm.model.signal import lowpass_iir, pad, quintic_spline, uniform_interval
 NAMED_COLUMNS = 5
 
 
+#: a motion whose frames are further apart than this (s) is reported (times in milliseconds?)
+SLOW_FRAME_INTERVAL = 0.5
+
+
 def _few(names: Sequence[str]) -> str:
     """The first :data:`NAMED_COLUMNS` names, then 'and N more'."""
     text = ", ".join(names[:NAMED_COLUMNS])
@@ -161,6 +165,11 @@ def inverse_dynamics_of_motion(
     times = motion.time.copy()
     if times.size < 6:
         raise InputError(f"{times.size} rows are too few", file=motion.source, expected="at least 6 rows")
+    step = float(np.median(np.diff(times)))
+    if step > SLOW_FRAME_INTERVAL:
+        warnings.warn(f"{motion.source or 'motion'}: frames are {step:.6g} s apart: are the times in milliseconds? "
+                      "Velocities and accelerations are per second of the time column (in ms they are 1e3 and 1e6 "
+                      "times too small)", stacklevel=2)
     keep = frames_in_range(times, time_range, motion.source)
     out_times = times[keep]
     fit_times, fit_values = times, values
