@@ -63,6 +63,10 @@ def matlab_filtfilt(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     return y[::-1][n_fact : n_fact + x.shape[0]]
 
 
+#: raw EMG sampled below twice this rate (Hz) is suspected of times in milliseconds
+MIN_EMG_RATE = 100.0
+
+
 def sampling_rate(time: np.ndarray) -> float:
     """The original's ``length(t) / (t(end) - t(1))`` (Hz)."""
     t = np.asarray(time, dtype=float)
@@ -100,7 +104,18 @@ def process_emg(
     fs = sampling_rate(time)
     for name, cutoff in (("high-pass", high_pass_cutoff), ("low-pass", low_pass_cutoff)):
         if not 0 < cutoff < fs / 2:
-            raise InputError(f"{name} cut-off {cutoff} Hz", element=name, expected=f"between 0 and {fs / 2:g} Hz (Nyquist)")
+            hint = f" (the EMG is sampled at {fs:g} Hz: are its times in milliseconds?)" if fs < 2 * MIN_EMG_RATE else ""
+            raise InputError(f"{name} cut-off {cutoff} Hz{hint}", element=name,
+                             expected=f"between 0 and {fs / 2:g} Hz (Nyquist)")
+    raw = np.abs(x).max(axis=0)
+    dead = np.flatnonzero(np.ptp(x, axis=0) <= 1e-12 * np.maximum(raw, 1e-300))
+    if dead.size:  # the across-channel demean would give it the others' signal
+        raise InputError(
+            f"EMG channel(s) {', '.join(repr(labels[i]) if labels else f'column {int(i) + 1}' for i in dead)} "
+            "carry no signal (the same value in every row: a dead electrode?)",
+            element="EMG columns",
+            expected="channels that vary over the trial (leave a dead channel out with --emg-channels)",
+        )
     b, a = butter(filter_order, 2.0 * high_pass_cutoff / fs, "high")
     x = matlab_filtfilt(b, a, x)
     x = x - (x.mean(axis=1, keepdims=True) if per_frame else x.mean(axis=0))

@@ -93,9 +93,15 @@ class PreprocessRequest:
 
 def process_emg_table(table: Table, options: EmgOptions = EmgOptions()) -> Table:
     """``processEmg`` on every column of a raw EMG table: the processed table (same times)."""
-    processed = process_emg(table.time, table.data, filter_order=options.filter_order,
-                            high_pass_cutoff=options.high_pass_cutoff, low_pass_cutoff=options.low_pass_cutoff,
-                            demean=options.demean, labels=table.labels)
+    try:
+        processed = process_emg(table.time, table.data, filter_order=options.filter_order,
+                                high_pass_cutoff=options.high_pass_cutoff, low_pass_cutoff=options.low_pass_cutoff,
+                                demean=options.demean, labels=table.labels)
+    except InputError as exc:  # name the raw EMG file
+        if exc.file is not None or table.source is None:
+            raise
+        raise InputError(exc.detail, file=table.source, line=exc.line, element=exc.element,
+                         expected=exc.expected) from exc
     return Table(time=table.time, labels=table.labels, data=processed, name="processedEmg", source=table.source)
 
 
