@@ -120,6 +120,13 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
     if never:
         warnings.warn(f"{_where(table)}: marker(s) {', '.join(never)} have no data in the frames used; ignored "
                       "(weight 0 in every frame)", stacklevel=2)
+    empty = np.flatnonzero(~(present & (values > 0)).any(axis=1)) if present.size else np.zeros(0, dtype=int)
+    if empty.size and len(never) < len(names):
+        shown = ", ".join(f"{time[i]:g}" for i in empty[:NAMED_MARKERS])
+        more = f" and {empty.size - NAMED_MARKERS} more" if empty.size > NAMED_MARKERS else ""
+        warnings.warn(f"{_where(table)}: {empty.size} frame(s) have no marker data (t = {shown}{more} s): nothing "
+                      "determines their pose, so their coordinates repeat the previous frame's (or follow the "
+                      "coordinate tasks); leave them out with a time range, or fill the gaps", stacklevel=2)
     return MarkerTrial(time=np.array(time), names=tuple(names), positions=np.array(positions),
                        weights=values, source=_where(table))
 
