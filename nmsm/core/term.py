@@ -382,6 +382,15 @@ class Term:
                 split_values = text.split()
                 if singular == "axis":  # "xyz", "x z" or "x,y": one term per named axis
                     split_values = [c for c in text.lower() if c in "xyz"]
+                repeated = sorted({v for v in split_values if split_values.count(v) > 1}, key=split_values.index)
+                if repeated:  # one term per name: a name listed twice would be weighted twice
+                    raise InputError(
+                        f"{', '.join(repr(v) for v in repeated)} listed more than once in term '{cls.type}'",
+                        file=spec.source.file,
+                        line=spec.field_lines.get(element, spec.source.line),
+                        element=f"<{element}>",
+                        expected=f"each name once in <{element}>",
+                    )
                 splits[singular] = split_values
                 continue
             if target not in fields:

@@ -138,7 +138,12 @@ def _scalar(doc: SettingsDocument, parent: etree._Element, spec: Setting, elemen
     if spec.kind == "boolean":
         return doc.boolean(parent, element, spec.default, required=required)
     if spec.kind == "names":
-        return doc.names(parent, element, spec.default if spec.default is not None else (), required=required)
+        names = doc.names(parent, element, spec.default if spec.default is not None else (), required=required)
+        repeated = sorted({n for n in names if names.count(n) > 1}, key=names.index)
+        if repeated:  # a trial or coordinate listed twice would count twice (or stop the run with a traceback)
+            raise doc.error(doc.child(parent, element), f"{', '.join(repr(n) for n in repeated)} listed more than once",
+                            element=f"<{element}>", expected=f"each name once in <{element}>")
+        return names
     if spec.kind == "numbers":
         return doc.numbers(parent, element, spec.default, required=required, count=spec.count)
     if spec.kind == "booleans":
