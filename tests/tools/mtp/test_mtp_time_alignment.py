@@ -152,3 +152,15 @@ def test_tutorial_emg_is_silent(case):
         warnings.simplefilter("always")
         run_settings(_settings(folder, tutorial))
     assert not [w for w in record if "EMG" in str(w.message) and "gait_1.sto" in str(w.message)]
+
+
+def test_emg_at_another_rate_says_so(case):
+    folder, tutorial = case
+    emg = folder / "preprocessed" / "EMGData" / "gait_1.sto"
+    table = read_storage(emg)
+    fine = np.linspace(table.time[0], table.time[-1], 2 * table.n_rows - 1)  # twice the ID rate: 277 rows
+    from nmsm.io.storage import table_from_columns, write_storage
+
+    write_storage(emg, table_from_columns(fine, {k: np.interp(fine, table.time, table.column(k)) for k in table.labels}))
+    with pytest.raises(InputError, match=r"it is sampled every 0.0055 s, IDData/gait_1.sto every 0.011 s \(resample it"):
+        run_settings(_settings(folder, tutorial))
