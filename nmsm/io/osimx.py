@@ -50,7 +50,7 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
 from nmsm.io.numbers import significant15
-from nmsm.io.xml_input import parse_xml_file, xml_input_error
+from nmsm.io.xml_input import element_text, parse_xml_file, xml_input_error
 
 #: version written when the model has none
 OSIMX_VERSION = "1.5.3"
@@ -250,7 +250,7 @@ class _Reader:
         return out
 
     def text(self, element: etree._Element) -> str:
-        return (element.text or "").strip()
+        return element_text(element)  # comments inside a value left out (lxml's .text stops at the first)
 
     def number(self, element: etree._Element) -> float:
         text = self.text(element)
