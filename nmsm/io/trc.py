@@ -33,6 +33,12 @@ from nmsm.io.text import BOM, read_text_file
 
 #: metres per unit
 UNIT_SCALE: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+#: other spellings of ``Units`` that OpenSim's ``Units`` class reads (exactly these)
+UNIT_ALIASES: dict[str, str] = {
+    "M": "m", "METERS": "m", "meters": "m",
+    "MM": "mm", "MILLIMETERS": "mm", "millimeters": "mm",
+    "CM": "cm", "CENTIMETERS": "cm", "centimeters": "cm",
+}
 _HEADER_KEYS = (
     "DataRate",
     "CameraRate",
@@ -174,13 +180,14 @@ def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
     values = _cells(lines[2])
     header = dict(zip(keys, values))
     units = header.get("Units", "m").strip()
+    units = UNIT_ALIASES.get(units, units)
     if units not in UNIT_SCALE:
         raise InputError(
             f"unknown units '{units}'",
             file=source,
             line=3,
             element="Units",
-            expected="one of " + ", ".join(UNIT_SCALE),
+            expected="one of " + ", ".join([*UNIT_SCALE, *UNIT_ALIASES]) + " (as OpenSim reads them)",
         )
     name_cells = _cells(lines[3])
     if len(name_cells) < 2 or name_cells[0] != "Frame#":
