@@ -12,7 +12,8 @@ the model's *rotational* coordinates it is given; it never guesses from a column
 analysis and EMG data simply never call it.
 
 NaN is an error unless the caller names the columns where it is allowed (``allow_nan``):
-in GRF files the centre-of-pressure columns are NaN while the foot is in the air.
+in GRF files the centre-of-pressure columns are NaN while the foot is in the air. An
+infinite value (``inf``, ``Infinity``) is an error in every column.
 
 Tables are written as OpenSim's ``Storage`` writes them: name line, ``version=1``,
 ``nRows``, ``nColumns``, ``inDegrees``, ``endheader``, tab-separated values in full double
@@ -363,6 +364,16 @@ def _raise_bad_number(rows: list[list[str]], row_lines: list[int], header: list[
 def _check_nan(
     values: np.ndarray, header: list[str], row_lines: list[int], source: Path | None, allowed: Callable[[str], bool]
 ) -> None:
+    infinite = np.isinf(values)
+    if infinite.any():  # 'inf' / 'Infinity' parse as numbers but are no data (no column allows them)
+        i, j = (int(k) for k in np.argwhere(infinite)[0])
+        raise InputError(
+            f"infinite value {float(values[i, j])!r} where data must be present",
+            file=source,
+            line=row_lines[i],
+            element=f"column '{header[j]}'",
+            expected="a finite number",
+        )
     bad = np.isnan(values)
     if not bad.any():
         return

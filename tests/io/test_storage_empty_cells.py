@@ -34,3 +34,12 @@ def test_trailing_tabs_alone_are_no_error_and_a_short_row_still_names_the_first_
     with pytest.raises(InputError) as info:
         parse_storage(TEXT.format(a="0.1", b="0.2").replace("0.1\t0.1\t0.2\t0.3", "0.1\t0.1\t0.2"))
     assert info.value.element.startswith("column 'TibAnt' (first missing value)")
+
+
+@pytest.mark.parametrize("text", ["inf", "-Infinity"])
+def test_infinite_values_are_refused_in_every_column(text: str) -> None:
+    """'inf' parses as a number: it reached MTP as a traceback (bounds -nan) or a solver error."""
+    with pytest.raises(InputError) as info:
+        parse_storage(TEXT.format(a="0.1", b=text), allow_nan=lambda label: True)
+    error = info.value
+    assert error.line == 6 and error.element == "column 'RecFem'" and "infinite value" in str(error)
