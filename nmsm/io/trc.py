@@ -266,14 +266,17 @@ def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
                 row.append(math.nan)
                 continue
             try:
-                row.append(float(cell))
+                value = float(cell)
+                if math.isinf(value):  # 'inf' parses as a number; it would be taken for a gap, silently
+                    raise ValueError(cell)
+                row.append(value)
             except ValueError:
                 raise InputError(
                     f"'{cell}' is not a number",
                     file=source,
                     line=i + 1,
                     element=f"column {j + 1} (marker '{names[(j - 2) // 3]}' {'XYZ'[(j - 2) % 3]})",
-                    expected="a number, or an empty cell for a gap",
+                    expected="a finite number, or an empty cell (or NaN) for a gap",
                 ) from None
         rows.append(row)
         row_lines.append(i + 1)

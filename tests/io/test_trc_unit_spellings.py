@@ -1,5 +1,5 @@
-"""`.trc` Units spelled as OpenSim's Units class also reads them (MM, millimeters, CM, METERS,
-...) are accepted (nmsm refused them: "unknown units 'MM'")."""
+"""`.trc` reading: Units spelled as OpenSim's Units class also reads them (MM, millimeters, CM, METERS,
+...) are accepted (nmsm refused them: "unknown units 'MM'"); an infinite marker value is an error.
 
 from __future__ import annotations
 
@@ -35,3 +35,13 @@ def test_other_units_are_refused(tmp_path: Path) -> None:
                     "60\t60\t1\t1\tinches\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\t2\t3\n")
     with pytest.raises(InputError, match="unknown units 'inches'"):
         read_trc(path)
+
+
+def test_infinite_marker_value_is_refused(tmp_path: Path) -> None:
+    """'inf' parses as a number; it was taken for a gap without a word."""
+    path = tmp_path / "m.trc"
+    path.write_text("PathFileType\t4\t(X/Y/Z)\tm.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\n"
+                    "60\t60\t2\t1\tm\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\t2\t3\n2\t0.1\tinf\t2\t3\n")
+    with pytest.raises(InputError) as info:
+        read_trc(path)
+    assert info.value.line == 8 and "marker 'A' X" in info.value.element and "'inf' is not a number" in str(info.value)
