@@ -1,5 +1,5 @@
 """`.trc` reading: Units spelled as OpenSim's Units class also reads them (MM, millimeters, CM, METERS,
-...) are accepted (nmsm refused them: "unknown units 'MM'"); an infinite marker value is an error.
+...) are accepted (nmsm refused them: "unknown units 'MM'"); an infinite marker value is an error."""
 
 from __future__ import annotations
 
