@@ -41,3 +41,18 @@ def test_filter_refuses_a_sampling_rate_rounding_to_zero():
     time = np.arange(30) * 11.0
     with pytest.raises(InputError, match="rounds to 0 Hz"):
         bspline.nodes_for_cutoff(time, np.sin(time)[:, None], 10.0)
+
+
+def test_missing_ground_reaction_rows_are_named_as_a_gap(synthetic_case, tmp_path):
+    """Rows missing from the GRF file used to be reported as 'sampled at other times'."""
+    folder = tmp_path / "case"
+    shutil.copytree(synthetic_case.folder, folder)
+    grf = read_storage(folder / "grf.sto")
+    keep = np.ones(grf.n_rows, dtype=bool)
+    keep[20:25] = False
+    write_storage(folder / "grf.sto", table_from_columns(grf.time[keep], {k: grf.column(k)[keep] for k in grf.labels},
+                                                         name="grf"))
+    settings = GroundContactPersonalizationSettings.from_document(read_settings_document(folder / "settings.xml"))
+    with pytest.warns(UserWarning, match=r"grf.sto: ground reactions sampled at other times than the motion .*"
+                                         r"\(rows are missing: a gap of [0-9.]+ s after [0-9.]+ s"):
+        load_feet(settings)
