@@ -30,10 +30,10 @@ from nmsm.io.storage import COP_SUFFIXES, Table, read_storage
 from nmsm.io.trials import find_trial_file
 from nmsm.tools.treatment.model_interface import TreatmentModel
 
-#: initial-guess files written by a previous TO/VO/DO: kind -> file suffix
 #: largest sample interval (s) of the tracked IK: more is taken for times in milliseconds
 LONGEST_SAMPLE_INTERVAL = 0.5
 
+#: initial-guess files written by a previous TO/VO/DO: kind -> file suffix
 RESULT_FILES = {
     "states": "_states",
     "accelerations": "_accelerations",
