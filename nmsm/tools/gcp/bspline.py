@@ -83,9 +83,11 @@ def _sample_rate(time: np.ndarray) -> float:
     """The original's sampling-rate estimate (Hz): from the first ten intervals, rounded
     to 10 Hz (fewer samples: from the first interval)."""
     rate = round(1.0 / (time[10] - time[0])) * 10.0 if len(time) > 10 else float(round(1.0 / (time[1] - time[0])))
-    if not rate > 0:
+    if not rate > 0:  # round() halves to even: 5 Hz (0.5 -> 0) rounds to 0 too
+        needed = ("more than 5 Hz (the rate is estimated from the first ten intervals and rounded to 10 Hz)"
+                  if len(time) > 10 else "more than 0.5 Hz")
         raise InputError(f"the sampling rate of frames {time[1] - time[0]:.6g} s apart rounds to 0 Hz",
-                         element="column 'time'", expected="times in seconds, sampled at 1 Hz or more")
+                         element="column 'time'", expected=f"times in seconds, sampled at {needed}")
     return rate
 
 

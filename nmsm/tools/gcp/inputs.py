@@ -163,7 +163,13 @@ def build_foot_inputs(index: int, surface: ContactSurfaceSettings, settings: Gro
         springs = place_springs(foot, settings.grid_width, settings.grid_height, spring_height=height,
                                 settings_file=settings_file)
     interval = float(np.mean(np.diff(time)))
-    n_nodes = bspline.nodes_for_cutoff(time, coordinates, settings.kinematics_filter_cutoff, KINEMATICS_DEGREE)
+    try:
+        n_nodes = bspline.nodes_for_cutoff(time, coordinates, settings.kinematics_filter_cutoff, KINEMATICS_DEGREE)
+    except InputError as exc:  # a sampling rate rounding to 0 Hz: name the motion file
+        if exc.file is not None:
+            raise
+        raise InputError(exc.detail, file=settings.input_motion_file, element=exc.element,
+                         expected=exc.expected) from exc
     basis, basis_rate, _ = bspline.bspline_matrices(KINEMATICS_DEGREE, n_nodes, time.size, interval)
     base_nodes = bspline.fit_nodes(basis, coordinates)
     markers_fn = foot.marker_function()
