@@ -236,7 +236,12 @@ class StageSettings:
             field.element.text = "" if value is None else cache.path(value)
         for comment in list(tree.iter(etree.Comment)):
             parent = comment.getparent()
-            if parent is not None:
+            if parent is not None:  # lxml's remove drops the tail: keep it, it is the value after the comment
+                previous = comment.getprevious()
+                if previous is not None:
+                    previous.tail = (previous.tail or "") + (comment.tail or "")
+                else:
+                    parent.text = (parent.text or "") + (comment.tail or "")
                 parent.remove(comment)
         for element in tree.iter():
             if element.text is not None and not element.text.strip():
