@@ -15,32 +15,7 @@ from nmsm.errors import InputError
 from nmsm.io.storage import read_storage
 from nmsm.tools.mtp.mtli import load_passive_trials
 from nmsm.tools.mtp.run import run_settings
-
-
-def _settings(folder: Path, tutorial: Path) -> Path:
-    path = folder / "MTPSettings.xml"
-    path.write_text(f"""<NMSMPipelineDocument Version="1.5.0"><MuscleTendonPersonalizationTool>
- <results_directory>results</results_directory>
- <input_model_file>{tutorial / 'UF_Subject_3_reduced_muscles.osim'}</input_model_file>
- <input_osimx_file/>
- <data_directory>preprocessed</data_directory>
- <coordinate_list>hip_flexion_r knee_angle_r ankle_angle_r</coordinate_list>
- <activation_muscle_groups>HamslatActivationGroupR</activation_muscle_groups>
- <normalized_fiber_length_muscle_groups/>
- <missing_emg_channel_muscle_groups>HipFlexorsMissingEMGChannelGroup</missing_emg_channel_muscle_groups>
- <collected_emg_channel_muscle_groups>GlutMaxLat RecFem BicFemLong BicFemShort VastMed GasMed Sol TibAnt</collected_emg_channel_muscle_groups>
- <max_iterations>50</max_iterations>
- <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
- <MTPSynergyExtrapolation><is_enabled>false</is_enabled></MTPSynergyExtrapolation>
- <MTPTaskList><MTPTask><is_enabled>true</is_enabled>
-  <muscle_specific_electromechanical_delays>true</muscle_specific_electromechanical_delays><RCNLCostTermSet>
-  <RCNLCostTerm><is_enabled>true</is_enabled><type>inverse_dynamics_joint_moment</type>
-   <max_allowable_error>2.5</max_allowable_error></RCNLCostTerm>
-  <RCNLCostTerm><is_enabled>true</is_enabled><type>emg_scale_factor</type>
-   <max_allowable_error>0.2</max_allowable_error><error_center>0.3</error_center></RCNLCostTerm>
- </RCNLCostTermSet></MTPTask></MTPTaskList>
-</MuscleTendonPersonalizationTool></NMSMPipelineDocument>""")
-    return path
+from test_mtp_bad_input import write_settings as _settings  # the same short tutorial run
 
 
 def _shift_times(path: Path, change) -> None:
@@ -164,3 +139,21 @@ def test_emg_at_another_rate_says_so(case):
     write_storage(emg, table_from_columns(fine, {k: np.interp(fine, table.time, table.column(k)) for k in table.labels}))
     with pytest.raises(InputError, match=r"it is sampled every 0.0055 s, IDData/gait_1.sto every 0.011 s \(resample it"):
         run_settings(_settings(folder, tutorial))
+
+
+def test_round_off_jitter_is_not_an_error_but_a_third_of_a_frame_is():
+    """The tolerance is a quarter of the ID file's median sample interval (MAData from OpenSim
+    prints its times rounded differently than the ID file)."""
+    from nmsm.io.storage import Table
+    from nmsm.tools.mtp.data import check_same_times
+
+    time = 0.5 + 0.011 * np.arange(101)
+    reference = Table(time=time, labels=(), data=np.zeros((101, 0)), source=Path("IDData/gait_1.sto"))
+
+    def other(times):
+        return Table(time=times, labels=(), data=np.zeros((times.size, 0)), source=Path("MAData/x.sto"))
+
+    check_same_times(reference, other(time + 1e-6 * (-1.0) ** np.arange(101)), "gait_1")
+    check_same_times(reference, other(time + 0.24 * 0.011), "gait_1")
+    with pytest.raises(InputError, match="data row 1 is at"):
+        check_same_times(reference, other(time + 0.3 * 0.011), "gait_1")
