@@ -90,8 +90,12 @@ def check_same_times(reference: Table, other: Table, prefix: str, *, padding: in
     ref_name = f"{source.parent.name}/{source.name}" if source is not None else "the ID file"
     rows = f"row {padding + k + 1}" + (f" (ID row {k + 1}; {padding} padding rows before it)" if padding else "")
     other_step = float(np.median(np.diff(other.time))) if other.n_rows > 1 else step
-    rate = (f"; it is sampled every {other_step:.6g} s, {ref_name} every {step:.6g} s (resample it to the ID frames, "
-            "as preprocessing does)" if step > 0 and abs(other_step / step - 1.0) > 0.01 else "")
+    rate = ""
+    if step > 0 and abs(other_step / step - 1000.0) <= 10.0:  # a unit, not a rate
+        rate = f"; it is sampled every {other_step:.6g} s, {ref_name} every {step:.6g} s: are its times in milliseconds?"
+    elif step > 0 and abs(other_step / step - 1.0) > 0.01:
+        rate = (f"; it is sampled every {other_step:.6g} s, {ref_name} every {step:.6g} s (resample it to the ID "
+                "frames, as preprocessing does)")
     raise InputError(
         f"trial '{prefix}': data {rows} is at {float(times[k])!r} s but {ref_name} is at "
         f"{float(reference.time[k])!r} s (off by {float(times[k] - reference.time[k]):.6g} s){rate}",

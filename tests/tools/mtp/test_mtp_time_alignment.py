@@ -157,3 +157,15 @@ def test_round_off_jitter_is_not_an_error_but_a_third_of_a_frame_is():
     check_same_times(reference, other(time + 0.24 * 0.011), "gait_1")
     with pytest.raises(InputError, match="data row 1 is at"):
         check_same_times(reference, other(time + 0.3 * 0.011), "gait_1")
+
+
+def test_emg_alone_in_milliseconds_asks_about_the_unit(case):
+    """Only the EMG file in ms (ID in s): the sampling-rate hint said 'resample it to the ID
+    frames'; a step 1000 times the ID's is a unit, not a rate."""
+    folder, tutorial = case
+    emg = folder / "preprocessed" / "EMGData" / "gait_1.sto"
+    _shift_times(emg, lambda t: t * 1000.0)
+    with pytest.raises(InputError) as info:
+        run_settings(_settings(folder, tutorial))
+    message = str(info.value)
+    assert str(emg) in message and "are its times in milliseconds?" in message and "resample" not in message
