@@ -10,10 +10,11 @@ tracked folder, the initial kinematics from the initial-guess folder (falling ba
 tracked ones). Times are shifted to start at 0 (each file's start is kept in
 ``TreatmentFiles.start_times``); IK degrees become radians for the model's rotational
 coordinates only. :func:`guess_time_problems` reports initial-guess files on other times than
-the tracked data. The tracked ID and GRF files must span the tracked IK's times (each is
-read from its own start, so one starting or ending elsewhere would be tracked shifted in
-time), and the tracked IK's frames must be at most 0.5 s apart (times in milliseconds):
-:class:`InputError` otherwise.
+the tracked data. The tracked ID and GRF files must start with the tracked IK (each is read
+from its own start, so one starting elsewhere would be tracked shifted in time) and last at
+least as long (a longer file is fine: only its first part is used); frames more than 0.5 s
+apart over more than 30 s are taken for times in milliseconds (a coarse collocation mesh of a
+short motion is not): :class:`InputError` otherwise.
 """
 
 from __future__ import annotations
@@ -30,8 +31,10 @@ from nmsm.io.storage import COP_SUFFIXES, Table, read_storage
 from nmsm.io.trials import find_trial_file
 from nmsm.tools.treatment.model_interface import TreatmentModel
 
-#: largest sample interval (s) of the tracked IK: more is taken for times in milliseconds
+#: largest sample interval (s) of a tracked IK longer than MILLISECOND_DURATION (s): more is
+#: taken for times in milliseconds (a 0.3 s kick in ms lasts "300 s" with "5 s" frames)
 LONGEST_SAMPLE_INTERVAL = 0.5
+MILLISECOND_DURATION = 30.0
 
 #: initial-guess files written by a previous TO/VO/DO: kind -> file suffix
 RESULT_FILES = {
@@ -152,10 +155,11 @@ def _check_tracked_times(ik: Table, others: tuple[Table | None, ...], starts: di
     """The tracked IK's frames in seconds, and the tracked ID/GRF files over the same times
     (within one IK sample interval; module docstring)."""
     step = float(np.median(np.diff(ik.time)))
-    if step > LONGEST_SAMPLE_INTERVAL:
-        raise InputError(f"the tracked IK's frames are {step:.6g} s apart: are the times in milliseconds?",
-                         file=ik.source, element="column 'time'",
-                         expected=f"times in seconds, frames at most {LONGEST_SAMPLE_INTERVAL} s apart")
+    if step > LONGEST_SAMPLE_INTERVAL and duration(ik) > MILLISECOND_DURATION:
+        raise InputError(f"the tracked IK's frames are {step:.6g} s apart over {duration(ik):.6g} s: are the times "
+                         "in milliseconds?", file=ik.source, element="column 'time'",
+                         expected=f"times in seconds (frames at most {LONGEST_SAMPLE_INTERVAL} s apart, or a "
+                         f"motion shorter than {MILLISECOND_DURATION:g} s)")
     start = starts.get(str(ik.source), 0.0)
     end = start + duration(ik)
     for table in others:
@@ -163,14 +167,15 @@ def _check_tracked_times(ik: Table, others: tuple[Table | None, ...], starts: di
             continue
         first = starts.get(str(table.source), 0.0)
         last = first + duration(table)
-        if abs(first - start) > step + 1e-9 or abs(last - end) > step + 1e-9:
+        if abs(first - start) > step + 1e-9 or last < end - step - 1e-9:
             kind = table.source.parent.name if table.source is not None else "tracked"
             raise InputError(
                 f"the tracked {kind} file covers {first:.6g}-{last:.6g} s but the tracked IK {ik.source} covers "
                 f"{start:.6g}-{end:.6g} s",
                 file=table.source, element="column 'time'",
-                expected=f"the tracked IK's times (within one sample interval, {step:.6g} s): each file is read from "
-                "its own start, so a file starting or ending elsewhere would be tracked shifted in time",
+                expected=f"a file starting with the tracked IK (within one sample interval, {step:.6g} s) and lasting "
+                "at least as long: each file is read from its own start, so one starting elsewhere would be tracked "
+                "shifted in time, and one ending earlier does not cover the motion",
             )
 
 

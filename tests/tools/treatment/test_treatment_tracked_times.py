@@ -108,3 +108,42 @@ def test_every_file_offset_alike_runs_as_without(shared_data: Path, tmp_path: Pa
     assert costs[0].keys() == costs[1].keys()
     for name, value in costs[0].items():
         np.testing.assert_allclose(np.asarray(costs[1][name], dtype=float), np.asarray(value, dtype=float), rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.shared_data
+def test_a_longer_tracked_id_file_is_read_over_the_motion(shared_data: Path, tmp_path: Path) -> None:
+    """An ID file starting with the IK and lasting longer is fine: only its first part is used
+    (the same costs as the file cut to the IK's times, to the 0.4 % by which the spline through
+    the later samples differs near the end from the cut file's end condition)."""
+    costs = []
+    for name, extra in (("plain", 0), ("longer", 20)):
+        folder = tmp_path / name
+        folder.mkdir()
+        settings, data = _case(shared_data, folder)
+        path = data / "IDData" / "arm1.sto"
+        table = read_storage(path)
+        if extra:
+            step = float(np.median(np.diff(table.time)))
+            time = np.concatenate([table.time, table.time[-1] + step * np.arange(1, extra + 1)])
+            def continued(v: np.ndarray) -> np.ndarray:  # the recording going on: the last slope continued
+                return np.concatenate([v, v[-1] + (v[-1] - v[-2]) * np.arange(1, extra + 1)])
+
+            write_storage(path, table_from_columns(time, {k: continued(table.column(k)) for k in table.labels}))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            costs.append(run_settings(settings, evaluate_only=True).solution.term_costs)
+    for term, value in costs[0].items():
+        np.testing.assert_allclose(np.asarray(costs[1][term], dtype=float), np.asarray(value, dtype=float),
+                                   rtol=1e-2, atol=1e-12)
+
+
+@pytest.mark.shared_data
+def test_a_short_motion_on_a_coarse_grid_is_not_taken_for_milliseconds(shared_data: Path, tmp_path: Path) -> None:
+    """Frames 0.6 s apart over a few seconds (a coarse collocation mesh of earlier results) are
+    seconds; only a long motion with sparse frames is taken for milliseconds."""
+    from nmsm.tools.treatment.inputs import _check_tracked_times
+
+    ik = table_from_columns(np.arange(0.0, 6.0, 0.6), {"q": np.zeros(10)})
+    _check_tracked_times(ik, (), {})
+    with pytest.raises(InputError, match="milliseconds"):
+        _check_tracked_times(table_from_columns(np.arange(0.0, 300.0, 5.0), {"q": np.zeros(60)}), (), {})
