@@ -114,7 +114,8 @@ def process_emg(
             f"EMG channel(s) {', '.join(repr(labels[i]) if labels else f'column {int(i) + 1}' for i in dead)} "
             "carry no signal (the same value in every row: a dead electrode?)",
             element="EMG columns",
-            expected="channels that vary over the trial (leave a dead channel out with --emg-channels)",
+            expected="channels that vary over the trial (leave a dead channel out of the raw EMG file, or with "
+                     "`nmsm preprocess --emg-channels`)",
         )
     b, a = butter(filter_order, 2.0 * high_pass_cutoff / fs, "high")
     x = matlab_filtfilt(b, a, x)
