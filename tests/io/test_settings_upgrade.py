@@ -138,6 +138,21 @@ def test_old_ncp_moment_term_is_renamed(shared_data: Path) -> None:
 
 
 @pytest.mark.shared_data
+def test_old_ncp_moment_term_after_a_comment_is_renamed(shared_data: Path, tmp_path: Path) -> None:
+    """The rename reads the type as the settings reader does, past a comment inside it."""
+    folder = shared_data / "ncp/patient3_bilateral_trials1to3"
+    text = (folder / "oldNCPSettingsFile.xml").read_text(encoding="utf-8")
+    old = "<type>inverse_dynamics_joint_moment</type>"
+    assert old in text
+    for entry in folder.iterdir():  # the settings' relative paths, without copying the data
+        (tmp_path / entry.name).symlink_to(entry)
+    copy = tmp_path / "edited.xml"
+    copy.write_text(text.replace(old, "<type><!-- 2023 -->inverse_dynamics_joint_moment</type>", 1), encoding="utf-8")
+    ncp = _quiet(read_tool_settings, copy)
+    assert [c.type for c in ncp.cost_terms][0] == "moment_tracking"
+
+
+@pytest.mark.shared_data
 def test_personalization_mappings(shared_data: Path) -> None:
     jmp = _quiet(read_tool_settings, shared_data / "jmp/gait2392_walk_free/JMPSettings.xml")
     (task,) = jmp.tasks

@@ -12,6 +12,7 @@ from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import TOOL_ELEMENTS, elements
 from nmsm.io.settings.upgrade import Upgrader, child_of
+from nmsm.io.xml_input import element_text, set_element_text
 
 #: 2021 JMP option names -> current
 JMP_OPTION_NAMES = {
@@ -195,9 +196,9 @@ def _rename_term_types(up: Upgrader, tool: etree._Element, mapping: dict[str, st
         return
     for term in elements(term_set):
         type_element = child_of(term, "type") if term.tag == "RCNLCostTerm" else None
-        old = (type_element.text or "").strip() if type_element is not None else ""
+        old = element_text(type_element)
         if old in mapping:
-            type_element.text = mapping[old]
+            set_element_text(type_element, mapping[old])
             up.note(type_element, f"cost <type> {old} renamed {mapping[old]}")
 
 

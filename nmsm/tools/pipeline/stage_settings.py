@@ -207,9 +207,9 @@ class StageSettings:
         root = results_root.resolve()
         changes = []  # collected first: a base element's new text must not change how others resolve
         for field in work.path_fields():
-            if field.element is None or not (field.element.text or "").strip():
+            if field.element is None or not element_text(field.element):
                 continue
-            value = Path(normalize_separators(field.element.text))
+            value = Path(normalize_separators(element_text(field.element)))
             if not value.is_absolute() or not _is_within(value.resolve(), root):
                 continue
             relative_to = field.base.resolve() if field.spec.base and field.base is not None else folder
@@ -217,7 +217,7 @@ class StageSettings:
                 continue  # keep absolute: relative text would be read against the base folder
             changes.append((field.element, Path(os.path.relpath(value.resolve(), relative_to)).as_posix()))
         for element, text in changes:
-            element.text = text
+            set_element_text(element, text)
         etree.indent(tree, space="  ")
         return etree.tostring(tree, pretty_print=True, xml_declaration=True, encoding="UTF-8").decode()
 
@@ -230,10 +230,10 @@ class StageSettings:
             if field.element is None:
                 continue
             if field.spec.output:
-                field.element.text = ""
+                set_element_text(field.element, "")
                 continue
             value = work.resolve(field)
-            field.element.text = "" if value is None else cache.path(value)
+            set_element_text(field.element, "" if value is None else cache.path(value))
         for comment in list(tree.iter(etree.Comment)):
             parent = comment.getparent()
             if parent is not None:  # lxml's remove drops the tail: keep it, it is the value after the comment

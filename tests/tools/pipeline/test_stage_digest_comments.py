@@ -36,3 +36,29 @@ def test_a_value_after_a_comment_changes_the_digest(shared_data: Path, tmp_path:
     same = _digest(shared_data, tmp_path, old, "<max_iterations>50<!-- was 1000 --></max_iterations>")
     assert first != second
     assert first == same  # the comment itself is not part of the digest
+
+
+@pytest.mark.shared_data
+def test_a_path_after_a_comment_is_written_and_digested_as_the_path(shared_data: Path, tmp_path: Path) -> None:
+    """A path value written after a comment (``<input_model_file><!-- c -->../m.osim``) is made
+    relative to the written stage file like any other, with nothing of the old text left
+    behind (it was skipped, absolute paths stayed, and the copy read them from its own folder)."""
+    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
+    text = (tutorial / "CompletedSettingsFiles" / "MTPSettingsV3.xml").read_text()
+    model = tmp_path / "results" / "models" / "model.osim"
+    model.parent.mkdir(parents=True)
+    model.write_bytes((tutorial / "UF_Subject_3_reduced_muscles.osim").read_bytes())
+    old = "<input_model_file>UF_Subject_3_reduced_muscles.osim</input_model_file>"
+    assert old in text
+    path = tmp_path / "CompletedSettingsFiles" / "MTPSettings.xml"
+    path.parent.mkdir()
+    path.write_text(text.replace(old, f"<input_model_file><!-- personalized -->{model}</input_model_file>", 1))
+    (tmp_path / "preprocessed").mkdir()
+    settings = StageSettings.from_file(path, MuscleTendonPersonalizationSettings)
+    stage_file = tmp_path / "results" / "mtp" / "MTPSettings.xml"
+    written = settings.text(stage_file, tmp_path / "results")
+    assert "<input_model_file>../models/model.osim<!-- personalized -->" in written and str(model) not in written
+    stage_file.parent.mkdir()
+    stage_file.write_text(written)
+    again = StageSettings.from_file(stage_file, MuscleTendonPersonalizationSettings)
+    assert again.resolve(next(f for f in again.path_fields() if f.spec.element == "input_model_file")).resolve() == model
