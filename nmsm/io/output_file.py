@@ -54,6 +54,34 @@ def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
 
 
 
+def read_only_folder(folder: str | os.PathLike[str]) -> bool:
+    """Whether ``folder`` is read-only: on a read-only filesystem, without a write permission bit
+    for anyone (``chmod a-w``: honoured even when running as root, who could write it anyway),
+    or not writable by this user. A missing folder is not read-only."""
+    folder = Path(folder)
+    try:
+        mode = folder.stat().st_mode
+    except OSError:
+        return False
+    if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH) or not os.access(folder, os.W_OK):
+        return True
+    try:
+        return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):
+        return False
+
+
+def check_default_folder_writable(folder: str | os.PathLike[str], what: str, option: str = OPTION) -> None:
+    """:class:`InputError` when a command's default output would go into the read-only ``folder``
+    (e.g. a shipped results folder): ``what`` names that output; the message asks for ``option``."""
+    if read_only_folder(folder):
+        raise InputError(
+            f"the results folder is read-only: {what} would be written into it by default; nothing was written",
+            file=Path(folder),
+            expected=f"{option} naming a writable place for {what}",
+        )
+
+
 def _check_parent(path: Path, option: str, kind: str) -> None:
     """:class:`InputError` when the folder ``path`` would go in is missing or is a file."""
     folder = path.parent

@@ -105,7 +105,7 @@ def _plot(args: argparse.Namespace) -> int:
     """``nmsm plot``: ``-o`` checked first (a folder, or a new one in an existing folder); the
     folders it created for a results folder that failed are removed again (:func:`plot_tree`)."""
     from nmsm.errors import InputError
-    from nmsm.io.output_file import check_output_folder
+    from nmsm.io.output_file import check_default_folder_writable, check_output_folder
 
     root = Path(args.results)
     if not root.is_dir():
@@ -113,6 +113,10 @@ def _plot(args: argparse.Namespace) -> int:
     output = None
     if args.output:
         output = check_output_folder(args.output, what="a folder for the figures (default: <each folder>/plots)")
+    else:
+        for _, folder in results_folders(root):
+            plots = folder / "plots"
+            check_default_folder_writable(plots if plots.is_dir() else folder, "the figures (<folder>/plots)")
     figures, errors = plot_tree(root, output)
     if not figures and not errors:
         print(f"nmsm: no results folder of JMP, MTP, NCP, GCP or treatment optimization in {root}", file=sys.stderr)

@@ -36,12 +36,14 @@ def _example(args: argparse.Namespace) -> int:
 def _report_target(args: argparse.Namespace) -> tuple[Path, Path]:
     """The results tree and the checked HTML file: never an existing non-HTML file of the tree."""
     from nmsm.errors import InputError
-    from nmsm.io.output_file import check_outputs
+    from nmsm.io.output_file import check_default_folder_writable, check_outputs
     from nmsm.report.html import REPORT_FILE
 
     root = Path(args.results)
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
+    if not args.output:
+        check_default_folder_writable(root, f"the report ({REPORT_FILE})")
     target = Path(args.output) if args.output else root / REPORT_FILE
     html = target.suffix.lower() in (".html", ".htm")  # the report reads no HTML: an earlier report is replaced
     folders = {} if html else {root: "the results tree being reported"}
