@@ -9,7 +9,8 @@ Written into the results folder (normalized synergies: largest weight of each ve
 * ``modelMoments/<trial>_modeledMomentsMtpNcpCombined.sto`` and ``_modeledMomentsNcp.sto``:
   muscle joint moments from the combined and from the NCP activations (ID labels);
 * ``<osimxBase>_ncp.osimx``: the input ``.osimx`` (or a new one named after the model) with
-  the synergy groups, and l_o / l_ts (F0 too when given) for every NCP muscle lacking them.
+  the synergy groups, and l_o / l_ts (F0 too when given) for every NCP muscle lacking them;
+  its ``associated_osim_model`` is NCP's input model (relative to the results folder).
 
 :func:`read_solution` reads ``synergyWeights.sto`` and the command files back into a
 :class:`SynergySolution` (used to score the MATLAB original's results and by Treatment
@@ -134,7 +135,10 @@ def ncp_osimx(
     ``updated_max_isometric_force``. The synergy set lists the NCP synergy groups
     (replacing groups of the same name, keeping others).
     """
-    base = input_osimx or OsimxModel(name=model_name, associated_osim_model=associated_model)
+    # the model NCP used, relative to the results folder: the input's own path was relative to the
+    # input .osimx's folder (or to the original tool's working folder) and breaks once copied here
+    base = (attrs.evolve(input_osimx, associated_osim_model=associated_model) if input_osimx is not None
+            else OsimxModel(name=model_name, associated_osim_model=associated_model))
     muscles = dict(base.muscles)
     params = inputs.muscles
     forced = set(updated_max_isometric_force)
