@@ -168,6 +168,15 @@ def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[s
     if output.resolve() == source.resolve():
         raise InputError("the export would overwrite its input model", file=output,
                          expected="another output file name")
+    if include_contact:
+        for surface in osimx.contact_surfaces:
+            if not surface.resting_spring_length > 0:  # the sphere radius (module docstring)
+                raise InputError(
+                    f"the resting spring length {surface.resting_spring_length:g} m of the contact surface on "
+                    f"'{surface.hindfoot_body}' is not positive: it cannot be an OpenSim contact sphere's radius",
+                    file=osimx_path, element="<resting_spring_length>",
+                    expected="--no-contact to export the model without the foot contact "
+                             "(apply the ground reactions as ExternalLoads)")
     writer = OsimWriter(source)
     updated = []
     for name, muscle in osimx.muscles.items():
