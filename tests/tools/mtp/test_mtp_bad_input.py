@@ -45,13 +45,6 @@ def write_settings(folder: Path, tutorial: Path, *, channels: str = "GlutMaxLat 
     return path
 
 
-@pytest.fixture
-def case(tmp_path, shared_data):
-    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
-    shutil.copytree(tutorial / "preprocessed", tmp_path / "preprocessed")
-    return tmp_path, tutorial
-
-
 def test_runs_clean(case):
     folder, tutorial = case
     outcome = run_settings(write_settings(folder, tutorial))

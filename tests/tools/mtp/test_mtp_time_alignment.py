@@ -28,13 +28,6 @@ def _shift_times(path: Path, change) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-@pytest.fixture
-def case(tmp_path, shared_data):
-    tutorial = shared_data / "mtp" / "uf_subject3_tutorial"
-    shutil.copytree(tutorial / "preprocessed", tmp_path / "preprocessed")
-    return tmp_path, tutorial
-
-
 def test_emg_of_another_time_window_is_an_error(case):
     folder, tutorial = case
     emg = folder / "preprocessed" / "EMGData" / "gait_1.sto"

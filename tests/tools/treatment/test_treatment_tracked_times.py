@@ -15,6 +15,7 @@ import pytest
 from nmsm.errors import InputError
 from nmsm.io.storage import read_storage, table_from_columns, write_storage
 from nmsm.tools.treatment.run import run_settings
+from test_treatment_input_checks import SOLVER  # the same coarse IPOPT settings
 
 SETTINGS = """<NMSMPipelineDocument Version="1.5.0"><TrackingOptimizationTool>
  <results_directory>{tmp}/results</results_directory>
@@ -32,13 +33,6 @@ SETTINGS = """<NMSMPipelineDocument Version="1.5.0"><TrackingOptimizationTool>
  </RCNLCostTermSet>
  <RCNLConstraintTermSet/>
 </TrackingOptimizationTool></NMSMPipelineDocument>
-"""
-SOLVER = """<NMSMPipelineDocument Version="1.5.0"><OptimalControlSolverSettings><GpopsSettings>
- <setup_mesh_method>none</setup_mesh_method><setup_mesh_phase_intervals>5</setup_mesh_phase_intervals>
- <setup_mesh_phase_colpoints_per_Interval>10</setup_mesh_phase_colpoints_per_Interval>
- <setup_nlp_solver>ipopt</setup_nlp_solver><setup_nlp_linear_solver>mumps</setup_nlp_linear_solver>
- <setup_nlp_tolerance>1e-3</setup_nlp_tolerance>
-</GpopsSettings></OptimalControlSolverSettings></NMSMPipelineDocument>
 """
 
 
