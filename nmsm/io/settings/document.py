@@ -356,10 +356,17 @@ def _to_float(text: str) -> float:
     return float(text)
 
 
+#: the largest integer setting: iteration and evaluation counts reach the solvers as C ints
+#: (IPOPT read max_iter 1e308 as 0 iterations), and an <index> becomes part of a folder name
+MAX_INTEGER = 2**31 - 1
+
+
 def _to_int(text: str) -> int:
     value = float(text)
     if not value.is_integer():
         raise ValueError(f"{text} is not a whole number")
+    if abs(value) > MAX_INTEGER:
+        raise ValueError(f"{text} is out of range (at most {MAX_INTEGER} in magnitude)")
     return int(value)
 
 
