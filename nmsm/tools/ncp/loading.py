@@ -209,7 +209,7 @@ def load_ncp(
     """Read everything NCP needs (see module docstring); ``enforce_bilateral_symmetry`` overrides the setting."""
     settings_file = settings.settings_file
     model = load_model(settings.input_model_file)
-    crossing = muscles_crossing(model, settings.coordinate_list)
+    crossing = muscles_crossing(model, settings.coordinate_list, settings_file=settings_file)
     requested = [(g.muscle_group_name, g.num_synergies) for g in settings.synergy_groups]
     groups = synergy_groups(model, requested, crossing, settings_file=settings_file)
     symmetric = settings.enforce_bilateral_symmetry if enforce_bilateral_symmetry is None else enforce_bilateral_symmetry

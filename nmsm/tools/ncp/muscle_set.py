@@ -20,8 +20,24 @@ from nmsm.model.components import Model
 from nmsm.tools.ncp.synergies import SynergyGroup
 
 
-def muscles_crossing(model: Model, coordinates: Sequence[str]) -> list[str]:
-    """Force-applying muscles (model order) with a path point on the child body of a joint owning a coordinate."""
+def muscles_crossing(model: Model, coordinates: Sequence[str], *, settings_file: str | Path | None = None) -> list[str]:
+    """Force-applying muscles (model order) with a path point on the child body of a joint owning a coordinate.
+
+    A name that is no coordinate of the model is an :class:`InputError` (the original's
+    ``getMusclesFromCoordinates`` fails on it too): it crosses nothing, so a misspelled
+    coordinate would silently leave its muscles out of the synergy groups.
+    """
+    known = set(model.coordinate_names)
+    for name in coordinates:
+        if name not in known:
+            close = close_matches(name, model.coordinate_names)
+            raise InputError(
+                f"'{name}' is not a coordinate of model {model.file}"
+                + (f"; close matches: {', '.join(close)}" if close else ""),
+                file=settings_file,
+                element="<coordinate_list>",
+                expected="coordinate names of the model",
+            )
     wanted = set(coordinates)
     bodies = {j.child_body for j in model.joints if wanted.intersection(j.coordinates)}
     out = []
