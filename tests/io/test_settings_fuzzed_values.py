@@ -61,3 +61,55 @@ def test_jmp_task_index_1e308_is_one_error_and_writes_nothing(shared_data: Path,
     assert "Traceback" not in err
     assert f"{settings}:18: <index>: '1e308' is not an integer: 1e308 is out of range" in err
     assert not results.exists()
+
+
+@pytest.mark.parametrize("text", ["nan", "inf", "-Infinity", "NaN"])
+def test_a_number_that_is_not_finite_is_an_error(tmp_path: Path, text: str) -> None:
+    # float() reads them; settings without a range check took them (GCP <belt_speed>nan, JMP
+    # <allowable_error>inf: the run finished), and inf passed every "must be > 0" check
+    path = tmp_path / "settings.xml"
+    path.write_text(f"""<NMSMPipelineDocument Version="1.5.3">
+  <GroundContactPersonalizationTool>
+    <belt_speed>{text}</belt_speed>
+    <translation_bounds>0.1 {text} 0.1</translation_bounds>
+  </GroundContactPersonalizationTool>
+</NMSMPipelineDocument>
+""")
+    doc = read_settings_document(path, check_paths=False)
+    with pytest.raises(InputError) as info:
+        doc.number(doc.tool_element, "belt_speed")
+    assert (info.value.line, info.value.element) == (3, "<belt_speed>")
+    assert f"'{text}' is not a number: {text} is not finite (expected a number)" in str(info.value)
+    with pytest.raises(InputError) as info:
+        doc.numbers(doc.tool_element, "translation_bounds", count=3)
+    assert (info.value.line, info.value.element) == (4, "<translation_bounds>")
+    assert f"{text} is not finite" in str(info.value)
+
+
+def test_jmp_allowable_error_inf_is_one_error_and_writes_nothing(shared_data: Path, tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    folder = _copy(shared_data, "jmp/toy_simple_arm", tmp_path)
+    settings = folder / "ToySettingsFile.xml"
+    text = settings.read_text()
+    assert text.count("<allowable_error>0.01</allowable_error>") == 1
+    settings.write_text(text.replace("<allowable_error>0.01</allowable_error>", "<allowable_error>inf</allowable_error>"))
+    results = tmp_path / "results"
+    assert main(["run", str(settings), "-o", str(results)]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert f"{settings}:11: <allowable_error>: 'inf' is not a number: inf is not finite" in err
+    assert not results.exists()
+
+
+def test_an_emptied_treatment_0_1_file_is_one_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the 0.1.0 upgrade took the first child unchecked: StopIteration traceback
+    path = tmp_path / "TO.xml"
+    path.write_text('<?xml version="1.0"?>\n<NMSMPipelineDocument Version="0.1.0">\n  <!-- nothing yet -->\n'
+                    "</NMSMPipelineDocument>\n")
+    with pytest.raises(InputError) as info:
+        read_settings_document(path)
+    assert (info.value.file, info.value.line, info.value.element) == (str(path), 2, "<NMSMPipelineDocument>")
+    assert "holds 0 elements" in str(info.value) and "<TrackingOptimizationTool>" in str(info.value)
+    assert main(["run", str(path), "-o", str(tmp_path / "results")]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "TO.xml:2: <NMSMPipelineDocument>: <NMSMPipelineDocument> holds 0 elements" in err

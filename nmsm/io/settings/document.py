@@ -18,7 +18,7 @@ file, the parent's line and the element. Only the literal text ``true`` is true 
 from __future__ import annotations
 
 import difflib
-
+import math
 import os
 import warnings
 from collections.abc import Iterator, Sequence
@@ -353,7 +353,10 @@ def to_bool(text: str) -> bool:
 
 
 def _to_float(text: str) -> float:
-    return float(text)
+    value = float(text)
+    if not math.isfinite(value):  # no setting means anything by nan or inf (float() reads both)
+        raise ValueError(f"{text.strip()} is not finite")
+    return value
 
 
 #: the largest integer setting: iteration and evaluation counts reach the solvers as C ints

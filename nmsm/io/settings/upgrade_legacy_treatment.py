@@ -75,7 +75,13 @@ def _text(element: etree._Element | None) -> str:
 
 def upgrade(up: Upgrader) -> None:
     """0.1.0 ``<TrackingOptimizationTool>`` / ``Verification`` / ``Design`` -> current."""
-    tool = next(elements(up.root))
+    tool = next(elements(up.root), None)
+    if tool is None:  # an emptied file: say so rather than fail inside the upgrade
+        raise InputError(
+            f"<{up.root.tag}> holds 0 elements", file=up.path, line=up.root.sourceline, element=f"<{up.root.tag}>",
+            expected="one tool element: <TrackingOptimizationTool>, <VerificationOptimizationTool> or "
+            "<DesignOptimizationTool>",
+        )
     up.flatten_sets()
     if tool.tag not in ("TrackingOptimizationTool", "VerificationOptimizationTool", "DesignOptimizationTool"):
         up.note(tool, f"version {up.root.get('Version')} <{tool.tag}>: no known 0.x differences; read as current")
