@@ -82,6 +82,7 @@ class JmpBody:
         default=(False, False, False),
         doc="Three true/false: the body's markers are free to move along x y z",
     )
+    source: SourceRef = setting(kind="source", doc="where the body is declared", default=SourceRef())
 
 
 @attrs.frozen(kw_only=True)

@@ -114,7 +114,12 @@ def check_names(model: Model, task: JmpTask, marker_file_names: Sequence[str], s
             raise _error(task, settings_file, f"joint '{joint.name}' is not in the model {model.file}"
                          + (f"; close matches: {', '.join(close)}" if close else ""),
                          f'<JMPJoint name="{joint.name}">', "a joint of the model", joint.source.line)
+    seen_bodies: set[str] = set()
     for body in task.bodies:
+        if body.name in seen_bodies:  # its scale would be declared twice (a ValueError traceback)
+            raise _error(task, settings_file, f"body '{body.name}' is listed twice", f'<JMPBody name="{body.name}">',
+                         "each body once per task (flag scaling and marker moves in one <JMPBody>)", body.source.line)
+        seen_bodies.add(body.name)
         if body.name not in model.bodies:
             close = close_matches(body.name, list(model.bodies))
             raise _error(task, settings_file, f"body '{body.name}' is not in the model {model.file}"
