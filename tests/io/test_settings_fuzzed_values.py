@@ -113,3 +113,30 @@ def test_an_emptied_treatment_0_1_file_is_one_error(tmp_path: Path, capsys: pyte
     assert main(["run", str(path), "-o", str(tmp_path / "results")]) == 1
     err = capsys.readouterr().err
     assert "Traceback" not in err and "TO.xml:2: <NMSMPipelineDocument>: <NMSMPipelineDocument> holds 0 elements" in err
+
+
+@pytest.mark.parametrize(("folder", "name", "tool"), [
+    ("treatment/toy_arm/tracking_optimization", "TorqueDrivenTOSettings.xml", "TrackingOptimizationTool"),
+    ("jmp/toy_simple_arm", "ToySettingsFile.xml", "JointModelPersonalizationTool"),
+])
+def test_an_old_schema_file_with_two_tool_elements_is_one_error(shared_data: Path, tmp_path: Path, folder: str,
+                                                               name: str, tool: str,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    # the 0.1.0 and OpenSimDocument upgrades read the first tool element and silently ignored a
+    # second one (the toy-arm TO ran); a current-schema file with two is already an error
+    from lxml import etree
+
+    settings = _copy(shared_data, folder, tmp_path) / name
+    tree = etree.parse(str(settings))
+    first = tree.getroot().find(tool)
+    first.addnext(etree.fromstring(etree.tostring(first)))
+    tree.write(str(settings))
+    second_line = etree.parse(str(settings)).getroot().findall(tool)[1].sourceline
+    results = tmp_path / "results"
+    assert main(["run", str(settings), "-o", str(results)]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    root = tree.getroot().tag
+    assert f"{settings}:{second_line}: <{tool}>: <{root}> holds 2 elements: <{tool}> (line " in err
+    assert f"(expected exactly one tool element in <{root}>" in err
+    assert not results.exists()

@@ -162,6 +162,13 @@ def upgrade_tree(root: etree._Element, path: str | os.PathLike[str]) -> UpgradeR
     work = copy.deepcopy(root)
     if schema == "current":
         return UpgradeResult(work, schema)
+    found = list(elements(root))
+    if schema in ("opensim-2023", "treatment-0.1") and len(found) > 1:  # the upgrade would read the first only
+        raise InputError(
+            f"<{root.tag}> holds {len(found)} elements: " + ", ".join(f"<{e.tag}> (line {e.sourceline})" for e in found),
+            file=path, line=found[1].sourceline, element=f"<{found[1].tag}>",
+            expected=f"exactly one tool element in <{root.tag}> (one settings file per tool run)",
+        )
     upgrader = Upgrader(work, path, schema)
     if schema == "opensim-2023":
         upgrade_legacy_personalization.upgrade(upgrader)
