@@ -29,6 +29,7 @@ while the velocity magnitude is 14.64 m/s.)
 from __future__ import annotations
 
 import importlib
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -45,9 +46,12 @@ def _option(term: Any, name: str, *, number: bool = False) -> Any:
     value = options[name]
     if number:
         try:
-            return float(value)
+            number_value = float(value)
         except ValueError:
             raise term.error(f"<{name}> = '{value}' is not a number", element=f"<{name}>") from None
+        if not math.isfinite(number_value):  # float() reads nan and inf: IPOPT then stopped at its first iterate
+            raise term.error(f"<{name}> = '{value}' is not finite", element=f"<{name}>", expected="a finite number")
+        return number_value
     return value
 
 
