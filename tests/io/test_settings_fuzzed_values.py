@@ -92,7 +92,8 @@ def test_jmp_allowable_error_inf_is_one_error_and_writes_nothing(shared_data: Pa
     settings = folder / "ToySettingsFile.xml"
     text = settings.read_text()
     assert text.count("<allowable_error>0.01</allowable_error>") == 1
-    settings.write_text(text.replace("<allowable_error>0.01</allowable_error>", "<allowable_error>inf</allowable_error>"))
+    settings.write_text(text.replace("<allowable_error>0.01</allowable_error>",
+                                     "<allowable_error>inf</allowable_error>"))
     results = tmp_path / "results"
     assert main(["run", str(settings), "-o", str(results)]) == 1
     err = capsys.readouterr().err
@@ -139,4 +140,29 @@ def test_an_old_schema_file_with_two_tool_elements_is_one_error(shared_data: Pat
     root = tree.getroot().tag
     assert f"{settings}:{second_line}: <{tool}>: <{root}> holds 2 elements: <{tool}> (line " in err
     assert f"(expected exactly one tool element in <{root}>" in err
+    assert not results.exists()
+
+
+def test_a_second_term_set_in_one_block_is_one_error(shared_data: Path, tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    # every <RCNLCostTermSet> of a block whose set is optional (MTLI, synergy extrapolation) was
+    # read: a copied set counted each of its terms twice (the MTP tutorial ran with the length
+    # initialization's terms doubled); a task's required set already refused a second one
+    from lxml import etree
+
+    folder = _copy(shared_data, "mtp/uf_subject3_tutorial", tmp_path)
+    settings = folder / "CompletedSettingsFiles" / "MTPSettingsV1.xml"
+    tree = etree.parse(str(settings))
+    task_set = tree.getroot().find("MuscleTendonPersonalizationTool/MuscleTendonLengthInitialization/RCNLCostTermSet")
+    first_line = task_set.sourceline
+    task_set.addnext(etree.fromstring(etree.tostring(task_set)))
+    tree.write(str(settings))
+    second_line = etree.parse(str(settings)).getroot().findall(
+        "MuscleTendonPersonalizationTool/MuscleTendonLengthInitialization/RCNLCostTermSet")[1].sourceline
+    results = tmp_path / "results"
+    assert main(["--progress", "0", "run", str(settings), "-o", str(results)]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert (f"{settings}:{second_line}: <RCNLCostTermSet>: <RCNLCostTermSet> appears 2 times in "
+            f"<MuscleTendonLengthInitialization> (first at line {first_line}) (expected one <RCNLCostTermSet>)") in err
     assert not results.exists()

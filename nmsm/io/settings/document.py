@@ -306,13 +306,15 @@ class SettingsDocument:
         for set_tag, (term_tag, term_kind) in TERM_SETS.items():
             if kind is not None and term_kind != kind:
                 continue
-            for term_set in self.children(parent, set_tag):
-                for term in elements(term_set):
-                    if term.tag != term_tag:
-                        raise self.error(
-                            term, f"unexpected <{term.tag}> in <{set_tag}>", expected=f"<{term_tag}> elements"
-                        )
-                    out.append(self.term_spec(term, term_kind))
+            term_set = self.child(parent, set_tag)  # a second set is an error: its terms would count twice
+            if term_set is None:
+                continue
+            for term in elements(term_set):
+                if term.tag != term_tag:
+                    raise self.error(
+                        term, f"unexpected <{term.tag}> in <{set_tag}>", expected=f"<{term_tag}> elements"
+                    )
+                out.append(self.term_spec(term, term_kind))
         return out
 
     def term_spec(self, term: etree._Element, kind: str) -> TermSpec:
