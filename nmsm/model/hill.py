@@ -17,6 +17,10 @@ Model (tendon rigid, no fiber dynamics, ``alpha`` = pennation at optimal fiber l
 * tendon force         ``F = F0 (a f_L f_V + f_P) cos alpha``                       [N]
 * joint moment         ``M_j = sum_m r_jm F_m``                                     [N m]
 
+The curves' constants are a :class:`MuscleCurves`: :data:`CURVES` (the pipeline's since
+2024, OpenSim's ``DeGrooteFregly2016Muscle``) by default; :data:`CURVES_2023` holds the
+earlier f_L and f_V constants the original's 2023 unit-test data were computed with.
+
 Activation (Meyer 2017 eqs 5-8):
 
 * excitation ``e(t) = s_emg * EMG(t - delay)`` (see :mod:`nmsm.tools.mtp.emg_spline`)
@@ -38,6 +42,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import attrs
 import numpy as np
 
 #: active force-length coefficients b1 (peak), b2 (centre), b3, b4 (width = b3 + b4 l)
@@ -58,6 +63,39 @@ FORCE_VELOCITY_D = (
 )
 #: passive force-length coefficients e1..e3
 PASSIVE_FORCE_LENGTH_E = (0.232000797810576, 12.438535493526128, 1.329470475731338)
+
+
+@attrs.frozen
+class MuscleCurves:
+    """Constants of the three normalized curves (module docstring: formulas).
+
+    ``active_force_length``: rows b1 (peaks), b2 (centres), b3, b4 (width ``b3 + b4 l``) of
+    the three Gaussians; ``force_velocity``: d1..d6; ``passive_force_length``: e1..e3.
+    """
+
+    active_force_length: tuple[tuple[float, float, float], ...]
+    force_velocity: tuple[float, float, float, float, float, float]
+    passive_force_length: tuple[float, float, float]
+
+
+#: the curves of the NMSM Pipeline since 2024 (OpenSim's DeGrooteFregly2016Muscle)
+CURVES = MuscleCurves(ACTIVE_FORCE_LENGTH_B, FORCE_VELOCITY_D, PASSIVE_FORCE_LENGTH_E)
+#: the curves of the original's early-2023 code, with which its 2023 MTP and NCP unit-test
+#: data (``mtp/cost_function_unit_2023``, ``ncp/cost_function_unit_2023``) were computed:
+#: f_L with De Groote et al. 2016's (supplement) constants, an earlier f_V fit (f_V(0) =
+#: 1.0005; nmsm-core commit a1fc3dca), the same f_P. They reproduce those data's model
+#: moments to 2e-15 of the peak (the current curves: 6.2e-4).
+CURVES_2023 = MuscleCurves(
+    (
+        (0.814483478343008, 0.433004984392647, 0.1),
+        (1.055033428970575, 0.716775413397760, 1.0),
+        (0.162384573599574, -0.029947116970696, 0.353553390593274),
+        (0.063303448465465, 0.200356847296188, 0.0),
+    ),
+    (-12.4090551101489, 9.35818070443882, 7.93116233095206, 2.70637350085154, -0.274108493130008,
+     8.03512618783281),
+    PASSIVE_FORCE_LENGTH_E,
+)
 #: activation nonlinearity coefficients g1..g6 (Meyer 2017 eq 8, relabelled)
 ACTIVATION_NONLINEARITY_G = (
     29.280183270562596,
@@ -113,14 +151,14 @@ def softplus(x: Any) -> Any:
 
 
 # ----- force-length-velocity curves -------------------------------------------------------
-def active_force_length(normalized_length: Any) -> Any:
+def active_force_length(normalized_length: Any, curves: MuscleCurves = CURVES) -> Any:
     """Normalized active fiber force ``f_L`` (-) at normalized fiber length (-)."""
     l = normalized_length
     casadi = _is_casadi(l)
     ops = _ops(l)
     if not casadi:
         l = np.asarray(l, dtype=float)
-    b1, b2, b3, b4 = ACTIVE_FORCE_LENGTH_B
+    b1, b2, b3, b4 = curves.active_force_length
     total = 0
     for i in range(3):
         width = b3[i] + b4[i] * l
@@ -133,16 +171,16 @@ def active_force_length(normalized_length: Any) -> Any:
     return total
 
 
-def force_velocity(normalized_velocity: Any) -> Any:
+def force_velocity(normalized_velocity: Any, curves: MuscleCurves = CURVES) -> Any:
     """Normalized force-velocity factor ``f_V`` (-) at normalized fiber velocity (-)."""
     ops = _ops(normalized_velocity)
-    d1, d2, d3, d4, d5, d6 = FORCE_VELOCITY_D
+    d1, d2, d3, d4, d5, d6 = curves.force_velocity
     return d1 + d2 * ops.arctan(d3 + d4 * ops.arctan(d5 + d6 * normalized_velocity))
 
 
-def passive_force_length(normalized_length: Any) -> Any:
+def passive_force_length(normalized_length: Any, curves: MuscleCurves = CURVES) -> Any:
     """Normalized passive fiber force ``f_P`` (-): ``e1 softplus(e2 (l - e3))``."""
-    e1, e2, e3 = PASSIVE_FORCE_LENGTH_E
+    e1, e2, e3 = curves.passive_force_length
     return e1 * softplus(e2 * (normalized_length - e3))
 
 
@@ -167,36 +205,39 @@ def normalized_fiber_velocity(
 
 
 # ----- forces and moments -------------------------------------------------------------------
-def passive_tendon_force(normalized_length: Any, max_isometric_force: Any, pennation_angle: Any) -> Any:
+def passive_tendon_force(normalized_length: Any, max_isometric_force: Any, pennation_angle: Any,
+                         curves: MuscleCurves = CURVES) -> Any:
     """Passive force along the tendon ``F0 f_P(l) cos alpha`` (N)."""
     ops = _ops(normalized_length, max_isometric_force, pennation_angle)
-    return max_isometric_force * passive_force_length(normalized_length) * ops.cos(pennation_angle)
+    return max_isometric_force * passive_force_length(normalized_length, curves) * ops.cos(pennation_angle)
 
 
 def active_tendon_force(
-    activation: Any, normalized_length: Any, normalized_velocity: Any, max_isometric_force: Any, pennation_angle: Any
+    activation: Any, normalized_length: Any, normalized_velocity: Any, max_isometric_force: Any, pennation_angle: Any,
+    curves: MuscleCurves = CURVES,
 ) -> Any:
     """Active force along the tendon ``F0 a f_L(l) f_V(v) cos alpha`` (N)."""
     ops = _ops(activation, normalized_length, normalized_velocity, max_isometric_force, pennation_angle)
     return (
         max_isometric_force
         * activation
-        * active_force_length(normalized_length)
-        * force_velocity(normalized_velocity)
+        * active_force_length(normalized_length, curves)
+        * force_velocity(normalized_velocity, curves)
         * ops.cos(pennation_angle)
     )
 
 
 def tendon_force(
-    activation: Any, normalized_length: Any, normalized_velocity: Any, max_isometric_force: Any, pennation_angle: Any
+    activation: Any, normalized_length: Any, normalized_velocity: Any, max_isometric_force: Any, pennation_angle: Any,
+    curves: MuscleCurves = CURVES,
 ) -> Any:
     """Total muscle-tendon force ``F0 (a f_L f_V + f_P) cos alpha`` (N)."""
     ops = _ops(activation, normalized_length, normalized_velocity, max_isometric_force, pennation_angle)
     return (
         max_isometric_force
         * (
-            activation * active_force_length(normalized_length) * force_velocity(normalized_velocity)
-            + passive_force_length(normalized_length)
+            activation * active_force_length(normalized_length, curves) * force_velocity(normalized_velocity, curves)
+            + passive_force_length(normalized_length, curves)
         )
         * ops.cos(pennation_angle)
     )

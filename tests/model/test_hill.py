@@ -38,10 +38,24 @@ def test_passive_softplus_is_stable():
     assert float(grad(1e3)) == pytest.approx(e1 * e2, rel=1e-12)
 
 
+@pytest.mark.parametrize("curves", [hill.CURVES, hill.CURVES_2023], ids=["current", "2023"])
 @pytest.mark.parametrize("func", [hill.active_force_length, hill.force_velocity, hill.passive_force_length])
-def test_casadi_matches_numpy(func):
+def test_casadi_matches_numpy(func, curves):
     x = np.linspace(-0.9, 1.8, 37)
-    assert np.allclose(_cs(func, x), func(x), rtol=1e-14, atol=1e-14)
+    assert np.allclose(_cs(lambda v: func(v, curves), x), func(x, curves), rtol=1e-14, atol=1e-14)
+
+
+def test_2023_curves_are_the_earlier_fits():
+    """The 2023 f_L is De Groote et al. 2016's (peak 0.9994 at l = 1), its f_V was not
+    normalized (f_V(0) = 1.0005); f_P is unchanged; the forces take the set given."""
+    assert hill.active_force_length(1.0, hill.CURVES_2023) == pytest.approx(0.99943, abs=1e-5)
+    assert hill.force_velocity(0.0, hill.CURVES_2023) == pytest.approx(1.000513, abs=1e-6)
+    assert hill.CURVES_2023.passive_force_length == hill.CURVES.passive_force_length
+    a, l, v, f0, alpha = 0.4, 0.9, 0.2, 1000.0, 0.1
+    expected = f0 * (a * hill.active_force_length(l, hill.CURVES_2023) * hill.force_velocity(v, hill.CURVES_2023)
+                     + hill.passive_force_length(l)) * np.cos(alpha)
+    assert hill.tendon_force(a, l, v, f0, alpha, hill.CURVES_2023) == pytest.approx(expected, rel=1e-14)
+    assert hill.tendon_force(a, l, v, f0, alpha) != pytest.approx(expected, rel=1e-4)
 
 
 def test_forces_and_moments():

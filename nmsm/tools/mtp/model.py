@@ -110,6 +110,7 @@ class TrialChain:
     Synergy Extrapolation path uses 4; see :class:`nmsm.tools.mtp.problem.MtpData`).
     ``clip_smoothing``: half-width (-) of the smooth ramp replacing "negative neural
     activations set to 0" (:func:`nmsm.model.hill.clip_negative`); 0 = the original's hard clip.
+    ``curves``: the force-length-velocity curves' constants (:class:`nmsm.model.hill.MuscleCurves`).
     """
 
     def __init__(
@@ -119,6 +120,7 @@ class TrialChain:
         stride: int = 4,
         clip_smoothing: float = 0.0,
         max_delay_variable: float = MAX_DELAY_VARIABLE,
+        curves: hill.MuscleCurves = hill.CURVES,
     ) -> None:
         if trial.emg_time is None:
             raise ValueError(f"trial '{trial.name}' has no EMG")
@@ -133,6 +135,7 @@ class TrialChain:
         self.dt = float(np.mean(np.diff(t)))
         self.padding = trial.padding
         self.max_delay = max_delay_variable / 10.0
+        self.curves = curves
         self.activation_function, self.force_function = self._build()
 
     def _build(self) -> tuple[cs.Function, cs.Function]:
@@ -163,7 +166,7 @@ class TrialChain:
         force = cs.Function(
             function_name("mtp_force", self.trial.name),
             [a, lnorm, vnorm, f0, alpha],
-            [hill.tendon_force(a, lnorm, vnorm, f0, alpha)],
+            [hill.tendon_force(a, lnorm, vnorm, f0, alpha, self.curves)],
             ["a", "l", "v", "F0", "alpha"],
             ["F"],
         )

@@ -84,7 +84,7 @@ class NcpContext:
         self.inputs = inputs
         self.weight_blocks = list(weight_blocks)
         self.activations = list(activations)
-        self.gains = list(gains) if gains is not None else [moment_gains(t, inputs.muscles, inputs.v_max_factor) for t in inputs.trials]
+        self.gains = list(gains) if gains is not None else [moment_gains(t, inputs.muscles, inputs.v_max_factor, inputs.curves) for t in inputs.trials]
         self._gain_matrices: list[Any] | None = None
 
     # ----- reductions ---------------------------------------------------------------------

@@ -45,13 +45,15 @@ def normalized_fiber_kinematics(
     return np.asarray(length), np.asarray(velocity)
 
 
-def moment_gains(trial: NcpTrial, muscles: MuscleParameters, v_max_factor: float) -> MomentGains:
-    """The activation-to-moment gains and passive moments of one trial."""
+def moment_gains(trial: NcpTrial, muscles: MuscleParameters, v_max_factor: float,
+                 curves: hill.MuscleCurves = hill.CURVES) -> MomentGains:
+    """The activation-to-moment gains and passive moments of one trial (``curves``: the
+    force-length-velocity curves' constants)."""
     length, velocity = normalized_fiber_kinematics(trial, muscles, v_max_factor)
     active_force = hill.active_tendon_force(
-        1.0, length, velocity, muscles.max_isometric_force, muscles.pennation_angle
+        1.0, length, velocity, muscles.max_isometric_force, muscles.pennation_angle, curves
     )  # (P, M)
-    passive_force = hill.passive_tendon_force(length, muscles.max_isometric_force, muscles.pennation_angle)
+    passive_force = hill.passive_tendon_force(length, muscles.max_isometric_force, muscles.pennation_angle, curves)
     active = trial.moment_arms * np.asarray(active_force)[:, None, :]
     passive = hill.joint_moments(trial.moment_arms, passive_force)
     return MomentGains(active=active, passive=passive)

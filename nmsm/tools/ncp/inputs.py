@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
+from nmsm.model import hill
 from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters
 from nmsm.tools.ncp.synergies import SynergyLayout
 
@@ -72,6 +73,7 @@ class NcpInputs:
     ``mtp_muscles``: muscles with MTP activations, in NCP muscle order (the columns of every
     trial's ``mtp_activations``). ``activation_groups`` / ``fiber_length_groups``: the
     settings' activation and normalized-fiber-length muscle groups restricted to NCP muscles.
+    ``curves``: the force-length-velocity curves' constants (the pipeline's by default).
     """
 
     layout: SynergyLayout
@@ -82,6 +84,7 @@ class NcpInputs:
     activation_groups: tuple[MuscleGroup, ...] = attrs.field(default=(), converter=tuple)
     fiber_length_groups: tuple[MuscleGroup, ...] = attrs.field(default=(), converter=tuple)
     v_max_factor: float = 10.0
+    curves: hill.MuscleCurves = hill.CURVES
 
     def __attrs_post_init__(self) -> None:
         m = self.layout.n_muscles

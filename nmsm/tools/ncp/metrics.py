@@ -45,7 +45,7 @@ def fit_metrics(inputs: NcpInputs, solution: SynergySolution) -> FitMetrics:
     idx = list(inputs.mtp_indices)
     for t, trial in enumerate(inputs.trials):
         a = solution.activations(t)
-        moments = moment_gains(trial, inputs.muscles, inputs.v_max_factor).moments(a)
+        moments = moment_gains(trial, inputs.muscles, inputs.v_max_factor, inputs.curves).moments(a)
         squared += np.sum((moments - trial.moments) ** 2, axis=0)
         frames += trial.n_points
         if idx and trial.mtp_activations is not None:

@@ -74,7 +74,7 @@ def write_trial_files(folder: Path, inputs: NcpInputs, solution: SynergySolution
         combined = combined_activations(inputs, solution, t)
         cols = {name: combined[:, m] for m, name in enumerate(layout.muscles)}
         written.append(write_storage(folder / f"{trial.name}{COMBINED_SUFFIX}", table_from_columns(trial.time, cols)))
-        gains = moment_gains(trial, inputs.muscles, inputs.v_max_factor)
+        gains = moment_gains(trial, inputs.muscles, inputs.v_max_factor, inputs.curves)
         labels = trial.load_labels or tuple(f"{c}_moment" for c in inputs.coordinates)
         for suffix, activations in ((COMBINED_MOMENTS_SUFFIX, combined), (NCP_MOMENTS_SUFFIX, solution.activations(t))):
             moments = gains.moments(activations)
