@@ -31,6 +31,10 @@ Compatibility on read:
   same warning. Comments are descriptive and are not kept.
 * The old ground-contact layout (``<RCNLGroundContact>``, ``<toes_coordinate>``) is an
   error: GCP must be re-run to name the ``hindfoot_body``.
+* Every number is finite (``nan``, ``inf``, ``1e400`` are errors: ``nmsm export`` wrote
+  them into the ``.osim``), and lengths, time constants, the EMG scale and the latching
+  velocity are > 0, the maximum isometric force and GCP's spring, damping and friction
+  coefficients >= 0 (``_SIGN_LIMITS``), each an ``InputError`` at the element's line.
 
 Applying the muscles to a model (MTP, NCP, treatment muscle and synergy controllers):
 :func:`check_muscles_in_model` makes an ``RCNLMuscle`` that names no muscle of the model an
@@ -39,6 +43,7 @@ Applying the muscles to a model (MTP, NCP, treatment muscle and synergy controll
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Iterable, Mapping
@@ -171,6 +176,30 @@ _SURFACE_FLOATS = (
 )
 _SURFACE_FIELDS = ("is_left_foot", "belt_speed", *_SURFACE_COLUMNS, *_SURFACE_TEXT, *_SURFACE_FLOATS)
 _SPRING_FIELDS = ("parent_body", "location", "spring_constant")
+#: fields whose sign is physical, and why: a zero or negative length, force or time constant
+#: has no meaning (the tools divide by them), GCP bounds its coefficients to >= 0. Resting
+#: spring length (GCP leaves it free: the tutorial's is -0.43 mm), belt speed (direction),
+#: activation nonlinearity, spring locations and the electromechanical delay (the original's
+#: Patient 3 MTP file holds -2.7e-40, round-off at MTP's bound 0; MTP clips it) may take any
+#: finite value.
+_SIGN_REASONS = {
+    "optimal_fiber_length": "a length in m",
+    "tendon_slack_length": "a length in m",
+    "max_isometric_force": "a force in N; 0 is kept: the original's own test files hold it",
+    "activation_time_constant": "a time constant in 0.01 s",
+    "emg_scale_factor": "the scale of the EMG",
+    "spring_constant": "GCP bounds spring constants to >= 0",
+    "damping_factor": "GCP bounds the damping factor to >= 0",
+    "dynamic_friction_coefficient": "GCP bounds friction coefficients to >= 0",
+    "viscous_friction_coefficient": "GCP bounds friction coefficients to >= 0",
+    "latching_velocity": "a velocity scale in m/s",
+}
+_SIGN_LIMITS = {
+    **dict.fromkeys(("optimal_fiber_length", "tendon_slack_length",
+                     "activation_time_constant", "emg_scale_factor", "latching_velocity"), "positive"),
+    **dict.fromkeys(("max_isometric_force", "spring_constant", "damping_factor",
+                     "dynamic_friction_coefficient", "viscous_friction_coefficient"), "non-negative"),
+}
 _SYNERGY_FIELDS = ("muscle_group_name", "num_synergies")
 
 #: the children the reader uses, per (current) parent element: anything else is "unknown"
@@ -253,11 +282,20 @@ class _Reader:
         return element_text(element)  # comments inside a value left out (lxml's .text stops at the first)
 
     def number(self, element: etree._Element) -> float:
+        """A finite number, within the field's sign limit (``_SIGN_LIMITS``) if it has one."""
         text = self.text(element)
         try:
-            return float(text)
+            value = float(text)
         except ValueError:
             raise self.error(element, f"'{text}' is not a number", "a number") from None
+        if not math.isfinite(value):  # no field means anything by nan or inf (float() reads both)
+            raise self.error(element, f"'{text}' is not a finite number", "a finite number")
+        limit = _SIGN_LIMITS.get(str(element.tag))
+        if limit is not None and not (value > 0 if limit == "positive" else value >= 0):
+            expected = "a number > 0" if limit == "positive" else "a number >= 0"
+            raise self.error(element, f"{text} is not {'positive' if limit == 'positive' else 'non-negative'}",
+                             f"{expected} ({_SIGN_REASONS[str(element.tag)]})")
+        return value
 
     def boolean(self, element: etree._Element) -> bool:
         text = self.text(element).lower()
@@ -270,9 +308,12 @@ class _Reader:
         if len(parts) != 3:
             raise self.error(element, f"expected 3 values, got {len(parts)}: '{self.text(element)}'", "three values")
         try:
-            return tuple(kind(p) for p in parts)
+            values = tuple(kind(p) for p in parts)
         except ValueError:
             raise self.error(element, f"'{self.text(element)}' are not numbers", "three numbers") from None
+        if kind is float and not all(math.isfinite(v) for v in values):
+            raise self.error(element, f"'{self.text(element)}' are not finite numbers", "three finite numbers")
+        return values
 
     def muscle(self, element: etree._Element, *, old_set: bool = False) -> OsimxMuscle:
         """One ``RCNLMuscle``; ``old_set``: inside a 2023 ``<MTPMuscleSet>`` (its scale factors already reported)."""
