@@ -33,6 +33,7 @@ import attrs
 from lxml import etree
 
 from nmsm.errors import InputError
+from nmsm.io.names import close_matches
 from nmsm.io.osimx import OsimxContactSurface, OsimxModel, read_osimx
 from nmsm.model.hill import time_constants_from_osimx
 from nmsm.model.osim_writer import OsimWriter, format_number, format_vector
@@ -156,6 +157,21 @@ def _add_contact(model: etree._Element, surfaces: tuple[OsimxContactSurface, ...
     return count
 
 
+def _check_spring_bodies(osimx: OsimxModel, bodies: list[str], osimx_path: Path, source: Path) -> None:
+    """Each spring's ``parent_body`` is a body of the model: the contact sphere's frame (an unknown
+    one was written as ``/bodyset/<name>`` and the exported model failed to load in OpenSim)."""
+    for k, surface in enumerate(osimx.contact_surfaces, start=1):
+        for spring in surface.springs:
+            if spring.parent_body in bodies:
+                continue
+            close = close_matches(spring.parent_body, bodies, n=3)
+            hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+            raise InputError(
+                f"the parent body '{spring.parent_body}' of spring '{spring.name}' (contact surface {k}) is not a "
+                f"body of the model {source}{hint}",
+                file=osimx_path, element="<parent_body>", expected="a body of the model: " + ", ".join(bodies))
+
+
 def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[str], *,
                  model_path: str | os.PathLike[str] | None = None, include_contact: bool = True,
                  reference_depth: float = REFERENCE_DEPTH) -> ExportReport:
@@ -178,6 +194,8 @@ def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[s
                     expected="--no-contact to export the model without the foot contact "
                              "(apply the ground reactions as ExternalLoads)")
     writer = OsimWriter(source)
+    if include_contact:
+        _check_spring_bodies(osimx, [e.get("name") for e in writer.reader.elements(["Body"])], osimx_path, source)
     updated = []
     for name, muscle in osimx.muscles.items():
         changed = False
