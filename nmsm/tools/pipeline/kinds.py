@@ -81,6 +81,8 @@ class StageKind:
     produces: tuple[str, ...] = ()
     wires: tuple[Wire, ...] = ()
     hook: str | Callable[..., Any] | None = None  #: (StageSettings, Artifacts, kept keys) -> {key: source}
+    #: the elements ``hook`` may rewire (with the wires' keys, the names ``keep_settings_inputs`` accepts)
+    hook_keys: tuple[str, ...] = ()
     run_options: Mapping[str, Any] = attrs.field(factory=dict)
     validate: str | Callable[[Any], None] | None = None  #: checks of the parsed settings (module docstring)
     bind: str | Callable[[Any], None] | None = None  #: binds the parsed settings' terms (module docstring)
@@ -106,6 +108,12 @@ class StageKind:
 
     def wires_for(self, artifact: str) -> tuple[Wire, ...]:
         return tuple(w for w in self.wires if w.artifact == artifact)
+
+    def rewired_keys(self) -> tuple[str, ...] | None:
+        """The elements the runner may rewire (``None``: not known, a hook without ``hook_keys``)."""
+        if self.hook is not None and not self.hook_keys:
+            return None
+        return (*(w.key for w in self.wires), *self.hook_keys)
 
 
 def _load(target: Any) -> Any:
@@ -168,7 +176,8 @@ _BUILT_IN = (
               wires=(Wire("model", "input_model_file"), Wire("osimx", "input_osimx_file"),
                      Wire("data_directory", "tracked_quantities_directory"),
                      Wire("surrogate_data", "RCNLSynergyController/surrogate_model_data_directory", True)),
-              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", run_options={"print_level": 0},
+              hook="nmsm.tools.pipeline.wiring:tracking_initial_guess", hook_keys=("initial_guess_directory",),
+              run_options={"print_level": 0},
               validate=_CHECK + "treatment", bind=_CHECK + "bind_treatment",
               has_terms=True),
     StageKind("vo", "Verification Optimization", "VerificationOptimizationTool", 90,

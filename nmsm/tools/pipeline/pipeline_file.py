@@ -179,9 +179,34 @@ def _read_stage(element: etree._Element, path: Path, earlier_codes: list[str]) -
     except ValueError:
         raise InputError(f"'{enabled_text}' is not a boolean", file=path, line=element.find("is_enabled").sourceline,
                          element="<is_enabled>", expected="true or false") from None
-    keep = tuple(_text(element.find("keep_settings_inputs")).split())
+    keep_element = element.find("keep_settings_inputs")
+    keep = tuple(_text(keep_element).split())
+    _check_keep(keep, kind, name, path, keep_element)
     return StageSpec(name=name, kind=kind, settings_file=settings_file, embedded=embedded, keep=keep,
                      enabled=enabled, file=path, line=line)
+
+
+def _check_keep(keep: tuple[str, ...], kind: StageKind, name: str, path: Path,
+                element: etree._Element | None) -> None:
+    """Each ``keep_settings_inputs`` name is an element the runner rewires for this kind (a
+    misspelled one kept nothing: the element was rewired, e.g. JMP's model given to a stage
+    meant to run on its own)."""
+    from nmsm.io.names import close_matches
+    from nmsm.tools.pipeline.wiring import is_kept
+
+    keys = kind.rewired_keys()
+    if keys is None:
+        return
+    for kept in keep:
+        if any(is_kept(key, (kept,)) for key in keys):
+            continue
+        names = sorted({*keys, *(k.rsplit("/", 1)[-1] for k in keys)})
+        close = close_matches(kept, names, n=2)
+        hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+        raise InputError(
+            f"stage '{name}' ({kind.code}): '{kept}' is no element the runner rewires for this stage, so keeping "
+            f"it would keep nothing{hint}", file=path, line=element.sourceline if element is not None else None,
+            element="<keep_settings_inputs>", expected="names (or paths) among " + ", ".join(names))
 
 
 def _default_name(code: str, earlier_codes: list[str]) -> str:
