@@ -40,6 +40,10 @@ from nmsm.tools.pipeline.stage_settings import StageSettings
 TOOL = "PipelineTool"
 _STAGE_ELEMENTS = ("is_enabled", "settings_file", "keep_settings_inputs")
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+#: longest stage name: its results folder's aside copy ``.<name>.earlier`` is one path
+#: component, at most 255 bytes on common file systems (a longer name was an OSError
+#: traceback, "File name too long", when the stage ran)
+MAX_NAME = 255 - len("..earlier")
 
 
 @attrs.frozen(eq=False)
@@ -114,6 +118,11 @@ def read_pipeline(path: str | os.PathLike[str]) -> PipelineSpec:
         raise InputError("no results folder", file=path, line=tool.sourceline, element="<results_directory>",
                          expected="<results_directory> naming the folder of the results tree")
     results = resolve_path(results_text, settings_file=path, base=path.parent, must_exist=False)
+    if results.exists() and not results.is_dir():  # was a FileExistsError traceback when the run made it
+        element = tool.find("results_directory")
+        raise InputError(f"'{results_text}' is a file ({results}), not a folder", file=path,
+                         line=element.sourceline, element="<results_directory>",
+                         expected="a folder for the results tree (absent or a folder)")
     inputs: dict[str, Path] = {}
     lines: dict[str, int | None] = {}
     for artifact, element_name in INPUT_ELEMENTS.items():
@@ -173,6 +182,9 @@ def _read_stage(element: etree._Element, path: Path, earlier_codes: list[str]) -
     if not _NAME.match(name):
         raise InputError(f"stage name '{name}' cannot name a folder", file=path, line=line, element="<Stage name>",
                          expected="letters, digits, '_', '-', '.' (not starting with '.')")
+    if len(name) > MAX_NAME:
+        raise InputError(f"stage name of {len(name)} characters ('{name[:20]}...') is too long for a folder name",
+                         file=path, line=line, element="<Stage name>", expected=f"at most {MAX_NAME} characters")
     enabled_text = _text(element.find("is_enabled"))
     try:
         enabled = to_bool(enabled_text) if enabled_text else True
