@@ -567,9 +567,9 @@ class ConstraintTerm(Term):
 def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> list[Term]:
     """Registered term instances for the enabled specs of ``tool``, in declaration order.
 
-    A term without ``<is_enabled>`` is not used (the original's default, false), with a
-    warning; an ``<is_enabled>`` other than true/false, and unknown or disallowed type names,
-    raise :class:`InputError` naming the file and line.
+    A term without ``<is_enabled>``, or with an empty one, is not used (the original's default,
+    false), with a warning; an ``<is_enabled>`` other than true/false, and unknown or
+    disallowed type names, raise :class:`InputError` naming the file and line.
     """
     from nmsm.core.registry import get_registry
 
@@ -578,11 +578,12 @@ def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> li
     for spec in specs:
         tag = "RCNLCostTerm" if spec.kind == "cost" else "RCNLConstraintTerm"
         where = _location(spec.source.file, spec.source.line)
-        if "is_enabled" not in spec.fields:  # the original's default: false (spec settings-xml.md)
-            warnings.warn(f"{where}<{tag}> '{spec.type}' has no <is_enabled>: not used "
+        text = spec.fields.get("is_enabled")
+        if text is None or not text.strip():  # the original's default: false (spec settings-xml.md)
+            state = "has no <is_enabled>" if text is None else "has an empty <is_enabled>"
+            warnings.warn(f"{where}<{tag}> '{spec.type}' {state}: not used "
                           f"(write <is_enabled>true</is_enabled>)", stacklevel=2)
             continue
-        text = spec.fields["is_enabled"]
         try:
             enabled = parse_bool(text)
         except ValueError as exc:
