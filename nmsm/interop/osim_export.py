@@ -34,7 +34,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
-from nmsm.io.osimx import OsimxContactSurface, OsimxModel, read_osimx
+from nmsm.io.osimx import OsimxContactSurface, OsimxModel, check_contact_surfaces, read_osimx
 from nmsm.model.hill import time_constants_from_osimx
 from nmsm.model.osim_writer import OsimWriter, format_number, format_vector
 
@@ -185,6 +185,7 @@ def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[s
         raise InputError("the export would overwrite its input model", file=output,
                          expected="another output file name")
     if include_contact:
+        check_contact_surfaces(osimx)
         for surface in osimx.contact_surfaces:
             if not surface.resting_spring_length > 0:  # the sphere radius (module docstring)
                 raise InputError(

@@ -115,6 +115,8 @@ class OsimxContactSurface:
     latching_velocity: float  #: m/s
     springs: tuple[GcpSpring, ...] = ()
     extra: tuple[str, ...] = attrs.field(default=(), converter=_xml_tuple)
+    #: line of the ``<RCNLContactSurface>`` in the file it was read from (None when built in code)
+    line: int | None = attrs.field(default=None, eq=False, repr=False)
 
 
 @attrs.frozen
@@ -379,7 +381,12 @@ class _Reader:
                     "<hindfoot_body> (osimx.md)",
                 )
             if child.tag == "GCPSpringSet":
-                springs.extend(self.spring(s) for s in self.members(child, "GCPSpring"))
+                for member in self.members(child, "GCPSpring"):
+                    spring = self.spring(member)
+                    if spring.name and any(spring.name == other.name for other in springs):
+                        raise self.error(member, f"spring '{spring.name}' appears twice in this contact surface",
+                                         "one <GCPSpring> per name")
+                    springs.append(spring)
             elif child.tag in _SURFACE_FIELDS:
                 found[child.tag] = child
             else:
@@ -393,6 +400,7 @@ class _Reader:
             belt_speed=self.number(found["belt_speed"]),
             springs=tuple(springs),
             extra=tuple(extra),
+            line=element.sourceline,
             **{k: self.triple(found[k], str) for k in _SURFACE_COLUMNS},
             **{k: self.text(found[k]) for k in _SURFACE_TEXT},
             **{k: self.number(found[k]) for k in _SURFACE_FLOATS},
@@ -456,7 +464,12 @@ class _Reader:
                     "<RCNLContactSurfaceSet> (osimx.md)",
                 )
             elif child.tag == "RCNLSynergySet":
-                synergies.extend(self.synergy(s) for s in self.members(child, "RCNLSynergy"))
+                for member in self.members(child, "RCNLSynergy"):
+                    synergy = self.synergy(member)
+                    if any(synergy.muscle_group_name == other.muscle_group_name for other in synergies):
+                        raise self.error(member, f"muscle group '{synergy.muscle_group_name}' has two <RCNLSynergy>",
+                                         "one <RCNLSynergy> per muscle group")
+                    synergies.append(synergy)
             else:
                 self.unknown(child, element)
                 extra.append(_serialize(child))
@@ -548,6 +561,31 @@ def check_muscles_in_model(
         element=f'<RCNLMuscle name="{first.name}">',
         expected=f"RCNLMuscle names that are muscles of the model: {shown}",
     )
+
+
+def check_contact_surfaces(osimx: OsimxModel, *, osimx_file: str | os.PathLike[str] | None = None) -> None:
+    """Raise :class:`InputError` unless each contact surface has springs and its own hindfoot body.
+
+    Called where the surfaces are applied as foot contact (treatment tools, ``nmsm export``):
+    a surface without springs was a CasADi "Slice ... out of bounds" while a term was built,
+    and two surfaces on one hindfoot body (an ``RCNLContactSurface`` copied, or the original's
+    GCP appending a re-run's surface to the input's) pushed that foot twice, silently. GCP
+    itself reads such a file: it replaces the surfaces of the feet it personalizes.
+    """
+    file = osimx_file if osimx_file is not None else osimx.source
+    seen: dict[str, OsimxContactSurface] = {}
+    for surface in osimx.contact_surfaces:
+        if not surface.springs:
+            raise InputError(f"the contact surface on '{surface.hindfoot_body}' has no springs", file=file,
+                             line=surface.line, element="<RCNLContactSurface>",
+                             expected="a <GCPSpringSet> holding GCP's springs (re-run GCP for this foot)")
+        first = seen.get(surface.hindfoot_body)
+        if first is not None:
+            at = f" (also at line {first.line})" if first.line is not None else ""
+            raise InputError(f"two contact surfaces on '{surface.hindfoot_body}'{at}: that foot would touch the "
+                             "ground twice", file=file, line=surface.line, element="<RCNLContactSurface>",
+                             expected="one <RCNLContactSurface> per hindfoot body")
+        seen[surface.hindfoot_body] = surface
 
 
 # ----- writing ----------------------------------------------------------------------------

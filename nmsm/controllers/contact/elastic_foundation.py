@@ -42,10 +42,11 @@ class ElasticFoundationContact(ContactModel):
     def discover(cls, setup: Any) -> list[ContactModel]:
         if setup.osimx is None or getattr(setup.model, "model", None) is None:
             return []
-        from nmsm.io.osimx import read_osimx
+        from nmsm.io.osimx import check_contact_surfaces, read_osimx
 
-        surfaces = read_osimx(setup.osimx).contact_surfaces
-        return [cls(s, setup.model.model, i) for i, s in enumerate(surfaces)]
+        osimx = read_osimx(setup.osimx)
+        check_contact_surfaces(osimx)
+        return [cls(s, setup.model.model, i) for i, s in enumerate(osimx.contact_surfaces)]
 
     def set_parameter(self, name: str, value: Any) -> None:
         """Replace one of ``CONTACT_PARAMETERS`` (e.g. ``belt_speed``) by a value or MX."""
