@@ -181,25 +181,27 @@ _SPRING_FIELDS = ("parent_body", "location", "spring_constant")
 #: fields whose sign is physical, and why: a zero or negative length, force or time constant
 #: has no meaning (the tools divide by them), GCP bounds its coefficients to >= 0. Resting
 #: spring length (GCP leaves it free: the tutorial's is -0.43 mm), belt speed (direction),
-#: activation nonlinearity, spring locations and the electromechanical delay (the original's
-#: Patient 3 MTP file holds -2.7e-40, round-off at MTP's bound 0; MTP clips it) may take any
-#: finite value.
+#: activation nonlinearity and spring locations may take any finite value; the
+#: electromechanical delay is >= 0 up to round-off (``_ROUND_OFF``: the original's Patient 3
+#: MTP file holds -2.7e-40 at MTP's bound 0; NCP copied a -1 into its output .osimx).
 _SIGN_REASONS = {
     "optimal_fiber_length": "a length in m",
     "tendon_slack_length": "a length in m",
     "max_isometric_force": "a force in N; 0 is kept: the original's own test files hold it",
     "activation_time_constant": "a time constant in 0.01 s",
     "emg_scale_factor": "the scale of the EMG",
+    "electromechanical_delay": "a delay in 0.1 s",
     "spring_constant": "GCP bounds spring constants to >= 0",
     "damping_factor": "GCP bounds the damping factor to >= 0",
     "dynamic_friction_coefficient": "GCP bounds friction coefficients to >= 0",
     "viscous_friction_coefficient": "GCP bounds friction coefficients to >= 0",
     "latching_velocity": "a velocity scale in m/s",
 }
+_ROUND_OFF = {"electromechanical_delay": 1e-9}
 _SIGN_LIMITS = {
     **dict.fromkeys(("optimal_fiber_length", "tendon_slack_length",
                      "activation_time_constant", "emg_scale_factor", "latching_velocity"), "positive"),
-    **dict.fromkeys(("max_isometric_force", "spring_constant", "damping_factor",
+    **dict.fromkeys(("electromechanical_delay", "max_isometric_force", "spring_constant", "damping_factor",
                      "dynamic_friction_coefficient", "viscous_friction_coefficient"), "non-negative"),
 }
 _SYNERGY_FIELDS = ("muscle_group_name", "num_synergies")
@@ -293,7 +295,7 @@ class _Reader:
         if not math.isfinite(value):  # no field means anything by nan or inf (float() reads both)
             raise self.error(element, f"'{text}' is not a finite number", "a finite number")
         limit = _SIGN_LIMITS.get(str(element.tag))
-        if limit is not None and not (value > 0 if limit == "positive" else value >= 0):
+        if limit is not None and not (value > 0 if limit == "positive" else value >= -_ROUND_OFF.get(element.tag, 0.0)):
             expected = "a number > 0" if limit == "positive" else "a number >= 0"
             raise self.error(element, f"{text} is not {'positive' if limit == 'positive' else 'non-negative'}",
                              f"{expected} ({_SIGN_REASONS[str(element.tag)]})")

@@ -7,7 +7,8 @@ of an ``.osimx`` is finite, and the fields whose sign is physical are checked wh
 is read, one error naming the file, the line, the element and what was expected. What the
 original tools write stays accepted: a negative resting spring length (GCP leaves it free),
 a zero maximum isometric force (the original's own test files), a negative belt speed and a
-round-off negative electromechanical delay (the original's Patient 3 MTP file: -2.7e-40).
+round-off negative electromechanical delay (the original's Patient 3 MTP file: -2.7e-40; NCP
+copied an input's nan or -1 delay into its output .osimx).
 """
 
 from __future__ import annotations
@@ -79,6 +80,7 @@ def test_a_spring_location_that_is_not_finite_is_an_error(location: str) -> None
     ("tendon_slack_length", "0", "> 0"), ("tendon_slack_length", "-1", "> 0"),
     ("activation_time_constant", "0", "> 0"), ("emg_scale_factor", "-0.4", "> 0"),
     ("latching_velocity", "0", "> 0"), ("max_isometric_force", "-6100", ">= 0"),
+    ("electromechanical_delay", "-1", ">= 0"), ("electromechanical_delay", "-0.01", ">= 0"),
     ("spring_constant", "-4100", ">= 0"), ("damping_factor", "-0.3", ">= 0"),
     ("dynamic_friction_coefficient", "-0.6", ">= 0"), ("viscous_friction_coefficient", "-1", ">= 0"),
 ])
