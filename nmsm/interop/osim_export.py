@@ -34,9 +34,16 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
-from nmsm.io.osimx import OsimxContactSurface, OsimxModel, check_contact_surfaces, read_osimx
+from nmsm.io.osimx import (
+    OsimxContactSurface,
+    OsimxModel,
+    check_contact_surfaces,
+    check_muscles_in_model,
+    read_osimx,
+)
 from nmsm.model.hill import time_constants_from_osimx
 from nmsm.model.osim_writer import OsimWriter, format_number, format_vector
+from nmsm.model.parse_forces import MUSCLE_TAGS
 
 #: depth (m) at which exported Hunt-Crossley contact matches the GCP spring's force
 REFERENCE_DEPTH = 0.005
@@ -195,6 +202,10 @@ def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[s
                     expected="--no-contact to export the model without the foot contact "
                              "(apply the ground reactions as ExternalLoads)")
     writer = OsimWriter(source)
+    # every RCNLMuscle, also one holding only what OpenSim cannot hold (delays, EMG scales):
+    # such an entry naming no muscle of the model was exported silently
+    check_muscles_in_model(osimx, [e.get("name") for e in writer.reader.elements(MUSCLE_TAGS)], model_file=source,
+                           osimx_file=osimx_path)
     if include_contact:
         _check_spring_bodies(osimx, [e.get("name") for e in writer.reader.elements(["Body"])], osimx_path, source)
     updated = []
