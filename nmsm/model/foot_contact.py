@@ -243,9 +243,10 @@ class ContactSurfaceModel:
         it belongs to (the toes body is the child of the hindfoot's one-coordinate joint)."""
         toes = toes_body_of(model, surface.hindfoot_body)
         bodies = tuple(s.parent_body for s in surface.springs)
-        for body in bodies:
-            if body not in (surface.hindfoot_body, toes):
-                raise ModelError(f"spring on body '{body}'", file=model.file,
+        for spring in surface.springs:
+            if spring.parent_body not in (surface.hindfoot_body, toes):
+                raise ModelError(f"spring '{spring.name}' is on body '{spring.parent_body}', not on the foot",
+                                 file=model.file, element="<parent_body>",
                                  expected=f"springs on '{surface.hindfoot_body}' or '{toes}'")
         return cls(
             hindfoot_body=surface.hindfoot_body,

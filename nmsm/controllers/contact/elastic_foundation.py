@@ -18,6 +18,7 @@ import numpy as np
 
 from nmsm.core.function_names import function_name
 from nmsm.core.plugin_bases import ContactModel
+from nmsm.errors import InputError, ModelError
 from nmsm.model.foot_contact import CONTACT_PARAMETERS, ContactSurfaceModel, contact_function, spring_forces
 
 
@@ -46,7 +47,14 @@ class ElasticFoundationContact(ContactModel):
 
         osimx = read_osimx(setup.osimx)
         check_contact_surfaces(osimx)
-        return [cls(s, setup.model.model, i) for i, s in enumerate(osimx.contact_surfaces)]
+        contacts = []
+        for i, surface in enumerate(osimx.contact_surfaces):
+            try:
+                contacts.append(cls(surface, setup.model.model, i))
+            except ModelError as exc:  # a body name of the .osimx the model lacks: name the .osimx, not the model
+                raise InputError(f"contact surface {i + 1}: {exc.detail} (model {exc.file})", file=osimx.source,
+                                 line=surface.line, element=exc.element, expected=exc.expected) from None
+        return contacts
 
     def set_parameter(self, name: str, value: Any) -> None:
         """Replace one of ``CONTACT_PARAMETERS`` (e.g. ``belt_speed``) by a value or MX."""
