@@ -242,6 +242,9 @@ class ContactSurfaceModel:
         """From an :class:`~nmsm.io.osimx.OsimxContactSurface` and the :class:`Model`
         it belongs to (the toes body is the child of the hindfoot's one-coordinate joint)."""
         toes = toes_body_of(model, surface.hindfoot_body)
+        if surface.midfoot_superior_marker not in model.marker_names:  # the moment reference (was found later)
+            raise ModelError(f"no marker '{surface.midfoot_superior_marker}'", file=model.file,
+                             element="<midfoot_superior_marker>", expected="a marker of the model")
         bodies = tuple(s.parent_body for s in surface.springs)
         for spring in surface.springs:
             if spring.parent_body not in (surface.hindfoot_body, toes):

@@ -1,7 +1,8 @@
-"""A body name of an .osimx contact surface that the model lacks, as the treatment tools apply
-the surface (fuzz audit of .osimx files): ``<hindfoot_body>no_such_body`` and a spring's
-``<parent_body>`` off the foot were errors naming the *model* file ("personalized.osim:
-<hindfoot_body>: no body ''", "personalized.osim: spring on body ''"), where the value is not.
+"""A body or marker name of an .osimx contact surface that the model lacks, as the treatment
+tools apply the surface (fuzz audit of .osimx files): ``<hindfoot_body>no_such_body``, a
+spring's ``<parent_body>`` off the foot and an unknown ``<midfoot_superior_marker>`` were errors
+naming the *model* file ("personalized.osim: <hindfoot_body>: no body ''", "personalized.osim:
+spring on body ''", "personalized.osim: no markers NO_SUCH"), where the value is not.
 Now the error names the .osimx, the surface's line and element, the spring, and the model."""
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ def _discover(shared_data, tmp_path, body_model, pattern: str | None = None, val
     (r"<hindfoot_body>calcn_r<", "<hindfoot_body>calcn_rr<", "<hindfoot_body>", "no body 'calcn_rr'"),
     (r"<parent_body>[^<]*<", "<parent_body>tibia_r<", "<parent_body>",
      "spring 'spring_marker_1' is on body 'tibia_r', not on the foot"),
+    (r"<midfoot_superior_marker>[^<]*<", "<midfoot_superior_marker>R_MIDFOOT<", "<midfoot_superior_marker>",
+     "no marker 'R_MIDFOOT'"),
 ])
 def test_a_body_of_the_osimx_the_model_lacks_names_the_osimx(shared_data, tmp_path, body_model, pattern, value,
                                                              element, message) -> None:
