@@ -229,6 +229,16 @@ _OLD_SCALE_FACTORS = (
 
 
 # ----- reading ----------------------------------------------------------------------------
+def _owner(element: etree._Element) -> str:
+    """``<RCNLMuscle> 'soleus_r': `` for a value inside a named element (muscle, spring,
+    surface), else ``''``: the start of a message about the value."""
+    for parent in element.iterancestors():
+        name = parent.get("name")
+        if name:
+            return f"<{parent.tag}> '{name}': "
+    return ""
+
+
 class _Reader:
     """One read of one file; ``messages`` collects its warnings (emitted by the caller)."""
 
@@ -293,11 +303,12 @@ class _Reader:
         except ValueError:
             raise self.error(element, f"'{text}' is not a number", "a number") from None
         if not math.isfinite(value):  # no field means anything by nan or inf (float() reads both)
-            raise self.error(element, f"'{text}' is not a finite number", "a finite number")
+            raise self.error(element, f"{_owner(element)}'{text}' is not a finite number", "a finite number")
         limit = _SIGN_LIMITS.get(str(element.tag))
         if limit is not None and not (value > 0 if limit == "positive" else value >= -_ROUND_OFF.get(element.tag, 0.0)):
             expected = "a number > 0" if limit == "positive" else "a number >= 0"
-            raise self.error(element, f"{text} is not {'positive' if limit == 'positive' else 'non-negative'}",
+            sign = "positive" if limit == "positive" else "non-negative"
+            raise self.error(element, f"{_owner(element)}{text} is not {sign}",
                              f"{expected} ({_SIGN_REASONS[str(element.tag)]})")
         return value
 
