@@ -134,13 +134,13 @@ def foot_ground_reactions(grf: Table, motion_time: np.ndarray, force_columns: tu
         values = values[rows]
     else:
         inside = (grf.time >= motion_time[0] - TIME_MATCH_TOLERANCE) & (grf.time <= motion_time[-1] + TIME_MATCH_TOLERANCE)
-        steps = np.diff(grf.time[inside]) if inside.sum() > 2 else np.diff(grf.time)
+        times = grf.time[inside] if inside.sum() > 2 else grf.time  # the motion's window, if it holds rows
+        steps = np.diff(times)
         gap = ""
         if steps.size > 1 and steps.max() > 1.5 * np.median(steps):  # rows missing, not another rate
             k = int(np.argmax(steps))
-            start = float(grf.time[inside][k]) if inside.sum() > 2 else float(grf.time[k])
-            gap = (f" (rows are missing: a gap of {float(steps[k]):.6g} s after {start:g} s, where the file is "
-                   f"otherwise sampled every {float(np.median(steps)):.6g} s)")
+            gap = (f" (rows are missing: a gap of {float(steps[k]):.6g} s after {float(times[k]):g} s, where the file "
+                   f"is otherwise sampled every {float(np.median(steps)):.6g} s)")
         warnings.warn(f"{grf_file}: ground reactions sampled at other times than the motion {motion_file}{gap}; "
                       "linearly interpolated onto the motion frames", stacklevel=2)
         values = np.column_stack([np.interp(motion_time, grf.time, values[:, k]) for k in range(values.shape[1])])
