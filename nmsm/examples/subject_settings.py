@@ -4,7 +4,8 @@
 range-of-motion settings file, then every other stage embedded (the analyses of the passive
 trials and of the gait trial on the personalized model, preprocessing, MTP with MTLI, NCP,
 GCP, surrogate data, and the
-treatment stages TO, VO, DO with their solver file ``<folder>/settings/solver.xml``).
+treatment stages TO, VO, DO with their solver files ``<folder>/settings/solver.xml`` and, for the
+DO, ``solver_do.xml``).
 Paths are relative to the pipeline file; inputs the runner rewires (model, osimx, data
 folders) name the subject's own files so each embedded block also reads on its own.
 """
@@ -235,12 +236,15 @@ SOLVER_XML = """<?xml version="1.0" encoding="UTF-8"?>
       <setup_mesh_phase_colpoints_per_Interval>12</setup_mesh_phase_colpoints_per_Interval>
       <setup_nlp_solver>ipopt</setup_nlp_solver>
       <setup_nlp_linear_solver>mumps</setup_nlp_linear_solver>
-      <setup_nlp_tolerance>1e-3</setup_nlp_tolerance>
+      <setup_nlp_tolerance>{tolerance}</setup_nlp_tolerance>
       <setup_nlp_max_iterations>300</setup_nlp_max_iterations>
     </GpopsSettings>
   </OptimalControlSolverSettings>
 </NMSMPipelineDocument>
 """
+#: IPOPT tolerance of the example's solver files: TO and VO ``solver.xml``, DO ``solver_do.xml``
+#: (Design Optimization applies at most 1e-6, ``solver_options.DESIGN_MAX_TOLERANCE``)
+SOLVER_TOLERANCES = {"solver.xml": "1e-3", "solver_do.xml": "1e-6"}
 #: the DO's "condition": strength (max isometric force scale) of the plantarflexors; the DO
 #: tracks the VO's synergy commands as the VO does, so its change from the VO is the
 #: predicted effect of the weakness alone (no compensation)
@@ -248,14 +252,15 @@ PLANTARFLEXORS = ("gastroc_r", "soleus_r")
 PLANTARFLEXOR_STRENGTH = 0.7
 
 
-def _treatment_common(subject: Subject, folder: Path, results: str, guess: str, tracked: str) -> str:
+def _treatment_common(subject: Subject, folder: Path, results: str, guess: str, tracked: str,
+                      solver: str = "solver.xml") -> str:
     coordinates = " ".join(sm.MUSCLE_COORDINATES)
     return f"""<results_directory>{results}</results_directory>
         <initial_guess_directory>{guess}</initial_guess_directory>
         <tracked_quantities_directory>{tracked}</tracked_quantities_directory>
         <input_model_file>{_relative(subject.generic_model, folder)}</input_model_file>
         <input_osimx_file>results/gcp/personalized_mtp_ncp_gcp.osimx</input_osimx_file>
-        <optimal_control_solver_settings_file>settings/solver.xml</optimal_control_solver_settings_file>
+        <optimal_control_solver_settings_file>settings/{solver}</optimal_control_solver_settings_file>
         <trial_name>{PREPROCESSED_TRIAL}</trial_name>
         <states_coordinate_list>{coordinates}</states_coordinate_list>"""
 
@@ -311,7 +316,7 @@ def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -
         <RCNLCostTermSet>{_term("controller_tracking", 1.0, controller_list=synergies)}</RCNLCostTermSet>
         <RCNLConstraintTermSet>{_consistency()}{_initial_state()}</RCNLConstraintTermSet>
       </VerificationOptimizationTool>"""
-    common = _treatment_common(subject, folder, "do", "results/vo", "results/vo")
+    common = _treatment_common(subject, folder, "do", "results/vo", "results/vo", solver="solver_do.xml")
     strength = PLANTARFLEXOR_STRENGTH
     costs = _term("controller_tracking", 1.0, controller_list=synergies)  # as VO: only the strength differs
     return f"""<DesignOptimizationTool>
@@ -351,7 +356,8 @@ def write_example_pipeline(subject: Subject, folder: str | os.PathLike[str], *, 
     """Write ``<folder>/pipeline.xml`` with ``stages`` (default: all available, in order)."""
     folder = Path(folder)
     (folder / "settings").mkdir(parents=True, exist_ok=True)
-    (folder / "settings" / "solver.xml").write_text(SOLVER_XML, encoding="utf-8")
+    for name, tolerance in SOLVER_TOLERANCES.items():
+        (folder / "settings" / name).write_text(SOLVER_XML.format(tolerance=tolerance), encoding="utf-8")
     blocks = stage_blocks(subject, folder, n_synergies)
     chosen = [s for s in (stages or STAGES) if s in blocks]
     body = "\n    ".join(blocks[s] for s in chosen)

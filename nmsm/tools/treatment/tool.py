@@ -27,7 +27,7 @@ from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_pro
 from nmsm.tools.treatment.model_interface import TreatmentModel
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.references import ReferenceSplines
-from nmsm.tools.treatment.solver_options import SolverPlan, plan_from_settings
+from nmsm.tools.treatment.solver_options import DESIGN_MAX_TOLERANCE, MAX_TOLERANCE, SolverPlan, plan_from_settings
 from nmsm.tools.treatment.term_defaults import default_error_warnings
 
 #: settings attribute of each controller element, in the order controls are laid out
@@ -228,7 +228,8 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
 
     options = options or TreatmentOptions()
     tool = settings.tool_code
-    plan = plan_from_settings(solver_settings.gpops, source=str(settings.optimal_control_solver_settings_file))
+    plan = plan_from_settings(solver_settings.gpops, source=str(settings.optimal_control_solver_settings_file),
+                              max_tolerance=DESIGN_MAX_TOLERANCE if tool == "DO" else MAX_TOLERANCE)
     model = OsimTreatmentModel(settings.input_model_file)
     tracked_dir = Path(options.tracked_quantities_directory or settings.tracked_quantities_directory)
     initial_dir = Path(options.initial_guess_directory or settings.initial_guess_directory)

@@ -171,17 +171,8 @@ def test_fixed_time_design_as_given(shared_data: Path, tmp_path: Path, name: str
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [
-    "TorqueDOSettingsV3", "SynergyDOSettingsV1",
-    pytest.param("TorqueDOSettingsV4", marks=pytest.mark.xfail(
-        strict=True, reason="local minimum: from the tutorial's guess IPOPT ends at 4.04e-4 (below the original's "
-                            "scored 4.69e-4); restarted from the original's solution it reaches 3.22e-4 "
-                            "(docs/treatment.md)")),
-    pytest.param("SynergyDOSettingsV2", marks=pytest.mark.xfail(
-        strict=True, reason="local minimum: from the tutorial's guess IPOPT ends at 6.2e-5 (below the original's "
-                            "scored 1.43e-4); restarted from the original's solution it reaches 5.0e-5 "
-                            "(docs/treatment.md)")),
-])
+@pytest.mark.parametrize("name", ["TorqueDOSettingsV3", "SynergyDOSettingsV1", "TorqueDOSettingsV4",
+                                  "SynergyDOSettingsV2"])
 def test_free_final_time_design_in_the_original_convention(shared_data: Path, tmp_path: Path, name: str) -> None:
     # the original keeps prescribed coordinates' data speeds when t_f changes; in that
     # convention its solution is (nearly) feasible for us
@@ -190,3 +181,20 @@ def test_free_final_time_design_in_the_original_convention(shared_data: Path, tm
     assert comp.ours.solution.success
     assert comp.ours.cost <= comp.theirs.initial_cost * (1 + 1e-6), comp.report()
     _goal_met_or_explained(comp, _settings(shared_data, name), **options)
+
+
+#: torque DO V4's objective when IPOPT restarts from the original's solution at tol 1e-6
+#: (benchmarks/bench_treatment.py, 2026-11-26; 0.0016270 from the tutorial's guess as well)
+TORQUE_DO_V4_POLISHED = 0.001627
+
+
+def test_design_goal_reaches_the_polished_minimum(shared_data: Path, tmp_path: Path) -> None:
+    """Torque DO V4 (free final time, final toe speed goal) from the tutorial's guess: with
+    the loose tolerance TO and VO use (1e-2 of the normalized objective) IPOPT stopped at
+    0.001763, 8 % above the minimum it reaches from the original's solution; Design
+    Optimization's own cap (1e-6) gets there."""
+    path = _settings(shared_data, "TorqueDOSettingsV4")
+    with pytest.warns(UserWarning, match=r"setup_nlp_tolerance=1 is looser than nmsm applies; IPOPT uses tol=1e-06"):
+        ours = run_settings(path, results_directory=tmp_path / "do", print_level=0)
+    assert ours.solution.success, ours.summary
+    assert ours.cost <= TORQUE_DO_V4_POLISHED * 1.02, ours.cost
