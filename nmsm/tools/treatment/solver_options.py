@@ -35,7 +35,7 @@ MAX_TOLERANCE = 1e-2
 #: objective stopped IPOPT early: torque DO V4 at 0.001763 instead of 0.001627, synergy DO V2
 #: (original time convention) at 6.205e-05 instead of 4.992e-05, the values IPOPT reaches
 #: from the original's solution. At 1e-6 the 11 kicking-tutorial DO runs end at those values
-#: (within 0.4 %), none higher than before, in 223 iterations and 61.6 s instead of 171 and
+#: (within 0.5 %), none higher than before, in 223 iterations and 61.6 s instead of 171 and
 #: 52.1 s (measured 2026-11-26, docs/treatment.md). TO and VO keep :data:`MAX_TOLERANCE`: there
 #: 1e-6 gains 0.3-0.7 % and costs up to 4 times the iterations.
 DESIGN_MAX_TOLERANCE = 1e-6
