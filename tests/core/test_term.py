@@ -143,30 +143,22 @@ class _OnlyOffsets:
         return _Offsets
 
 
-def test_a_term_without_is_enabled_is_not_used_and_warned_about() -> None:
+@pytest.mark.parametrize("given,message", [
+    ({}, "has no <is_enabled>"),
+    # <is_enabled/> (or blank) is read as the missing element is: it used to switch the term
+    # off silently (fuzz audit)
+    ({"is_enabled": " "}, "has an empty <is_enabled>"),
+])
+def test_a_term_without_a_usable_is_enabled_is_not_used_and_warned_about(given: dict, message: str) -> None:
     from nmsm.core.term import build_terms
 
-    specs = [TermSpec("cost", "offsets", {"values": "1"}, SourceRef("s.xml", 21)),
+    specs = [TermSpec("cost", "offsets", {**given, "values": "1"}, SourceRef("s.xml", 21)),
              TermSpec("cost", "offsets", {"is_enabled": "true", "values": "2"}, SourceRef("s.xml", 25))]
     with pytest.warns(UserWarning) as record:
         terms = build_terms(specs, "MTP", registry=_OnlyOffsets())
     assert [t.values for t in terms] == [(2.0,)]
     assert [str(w.message) for w in record] == [
-        "s.xml:21: <RCNLCostTerm> 'offsets' has no <is_enabled>: not used (write <is_enabled>true</is_enabled>)"]
-
-
-def test_a_term_with_an_empty_is_enabled_is_not_used_and_warned_about() -> None:
-    """``<is_enabled/>`` (or blank) is read as the missing element is: not used, with a warning
-    (it used to switch the term off silently; fuzz audit)."""
-    from nmsm.core.term import build_terms
-
-    specs = [TermSpec("cost", "offsets", {"is_enabled": " ", "values": "1"}, SourceRef("s.xml", 21)),
-             TermSpec("cost", "offsets", {"is_enabled": "true", "values": "2"}, SourceRef("s.xml", 25))]
-    with pytest.warns(UserWarning) as record:
-        terms = build_terms(specs, "MTP", registry=_OnlyOffsets())
-    assert [t.values for t in terms] == [(2.0,)]
-    assert [str(w.message) for w in record] == [
-        "s.xml:21: <RCNLCostTerm> 'offsets' has an empty <is_enabled>: not used (write <is_enabled>true</is_enabled>)"]
+        f"s.xml:21: <RCNLCostTerm> 'offsets' {message}: not used (write <is_enabled>true</is_enabled>)"]
 
 
 def test_is_enabled_other_than_true_or_false_names_file_line_and_element() -> None:
