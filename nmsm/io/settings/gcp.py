@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 import attrs
 
 from nmsm.core.term import SourceRef, TermSpec
+from nmsm.errors import InputError
 from nmsm.io.settings.document import SettingsDocument
 from nmsm.io.settings.schema import ReadContext, at_least_one, non_negative, positive, read_block, setting
 
@@ -113,6 +114,32 @@ class ContactSurfaceSettings:
                 f"end_time {values['end_time']} is not after start_time {values['start_time']}",
                 "start_time < end_time",
             )
+
+
+def surface_label(surface: ContactSurfaceSettings, index: int) -> str:
+    """``<GCPContactSurface> NAME`` (or its 1-based ``index`` among the enabled surfaces)."""
+    return f"<GCPContactSurface> {surface.name or index}"
+
+
+def check_distinct_feet(surfaces: tuple[ContactSurfaceSettings, ...], settings_file: Path | None) -> None:
+    """Each enabled surface is another foot: its own hindfoot body and its own force columns
+    (two surfaces on one foot, or reading one plate, would fit one set of reactions twice)."""
+    first: dict[tuple[str, tuple[str, ...]], tuple[int, ContactSurfaceSettings]] = {}
+    for index, surface in enumerate(surfaces, start=1):
+        for element, key in (("hindfoot_body", surface.hindfoot_body), ("force_columns", surface.force_columns)):
+            if not key:
+                continue
+            seen = first.setdefault((element, key), (index, surface))
+            if seen[1] is surface:
+                continue
+            other = seen[1]
+            where = f" (line {other.source.line})" if other.source.line is not None else ""
+            shown = key if isinstance(key, str) else " ".join(key)
+            raise InputError(f"'{shown}' is also the <{element}> of {surface_label(other, seen[0])}{where}: the "
+                             "same foot twice", file=settings_file, line=surface.source.line,
+                             element=f"{surface_label(surface, index)}: <{element}>",
+                             expected="one <GCPContactSurface> per foot, each with its own hindfoot body and its "
+                                      "own force-plate columns")
 
 
 @attrs.frozen(kw_only=True)
@@ -354,6 +381,7 @@ class GroundContactPersonalizationSettings:
                 "no enabled <GCPContactSurface>",
                 "at least one surface with <is_enabled>true</is_enabled>",
             )
+        check_distinct_feet(values["contact_surfaces"], ctx.doc.path)
 
     @classmethod
     def from_document(cls, doc: SettingsDocument) -> GroundContactPersonalizationSettings:

@@ -114,18 +114,22 @@ def match_rows(motion_time: np.ndarray, grf: Table, grf_file: Path, motion_file:
 
 def foot_ground_reactions(grf: Table, motion_time: np.ndarray, force_columns: tuple[str, ...],
                           moment_columns: tuple[str, ...], center_columns: tuple[str, ...], *,
-                          grf_file: Path, motion_file: Path, settings_file: Path | None, line: int | None) -> GroundReactions:
-    """The foot's ground reactions on the motion frames (module docstring)."""
+                          grf_file: Path, motion_file: Path, settings_file: Path | None, line: int | None,
+                          surface: str | None = None) -> GroundReactions:
+    """The foot's ground reactions on the motion frames (module docstring); ``surface``
+    (e.g. ``<GCPContactSurface> Left foot``) prefixes the element in error messages."""
+    where = f"{surface}: " if surface else ""
     for element, columns in (("force_columns", force_columns), ("moment_columns", moment_columns),
                              ("electrical_center_columns", center_columns)):
         if len(columns) != 3:
             raise InputError(f"<{element}> names {len(columns)} columns", file=settings_file, line=line,
-                             element=f"<{element}>", expected="three column names (X Y Z)")
+                             element=f"{where}<{element}>", expected="three column names (X Y Z)")
         for label in columns:
             if not grf.has(label):
                 missing = grf.missing_column(label)
                 raise InputError(f"<{element}> names column '{label}', which {grf_file} does not have "
-                                 f"({missing.detail})", file=settings_file, line=line, element=f"<{element}>",
+                                 f"({missing.detail})", file=settings_file, line=line,
+                                 element=f"{where}<{element}>",
                                  expected=f"columns of {grf_file.name}: {', '.join(grf.labels)}")
     rows = match_rows(motion_time, grf, grf_file, motion_file)
     labels = list(force_columns) + list(moment_columns) + list(center_columns)

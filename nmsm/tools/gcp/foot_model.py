@@ -85,7 +85,7 @@ class FootModel:
                 raise InputError(f"the model has no marker '{name}' ({role} marker of the foot on "
                                  f"'{self.hindfoot_body}')", file=settings_file, element=f"<{role}_marker>",
                                  expected=f"a marker of {self.model.file} on '{self.hindfoot_body}' or "
-                                          f"'{self.toes_body}'")
+                                          f"'{self.toes_body}'" + self._other_side_hint(name, index))
             marker = self.model.markers[index[name]]
             if marker.body not in (self.hindfoot_body, self.toes_body):
                 raise InputError(f"marker '{name}' ({role}) is on body '{marker.body}'", file=settings_file,
@@ -94,6 +94,16 @@ class FootModel:
             location = np.array(self._kinematics.marker_in_body(index[name])).ravel()
             points.append((marker.body, location))
         return points
+
+    def _other_side_hint(self, name: str, index: dict[str, int]) -> str:
+        """How to add a missing marker whose other-side twin the model has (``L_Toe_Medial``
+        for ``R_Toe_Medial``), else ''."""
+        for twin in other_side_names(name):
+            if twin in index:
+                body = self.model.markers[index[twin]].body
+                return (f"; the model has '{twin}' on '{body}': add '{name}' to the model on this foot's body at "
+                        f"its mirror image (z negated)")
+        return ""
 
     def toes_pose_in_hindfoot(self, toe_angle: object) -> tuple[cs.SX, cs.SX]:
         """``(R, p)``: orientation and origin of the toes frame in the hindfoot frame."""
@@ -180,6 +190,18 @@ def yxz_angles(rotation: np.ndarray) -> np.ndarray:
     a = np.arctan2(r[0, 2], r[2, 2])
     c = np.arctan2(r[1, 0], r[1, 1])
     return np.array([a, b, c])
+
+
+_SIDE_SWAPS = (("R_", "L_"), ("L_", "R_"), ("r_", "l_"), ("l_", "r_"))
+
+
+def other_side_names(name: str) -> list[str]:
+    """The other foot's spellings of a marker name (``R_Heel`` -> ``L_Heel``, ``heel_r`` ->
+    ``heel_l``)."""
+    out = [other + name[len(side):] for side, other in _SIDE_SWAPS if name.startswith(side)]
+    out += [name[: -len(side)] + other for side, other in (("_r", "_l"), ("_l", "_r"), ("_R", "_L"), ("_L", "_R"))
+            if name.endswith(side)]
+    return out
 
 
 def foot_coordinates(rotation: np.ndarray, origin: np.ndarray, toe_angle: float, is_left: bool) -> np.ndarray:

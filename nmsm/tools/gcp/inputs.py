@@ -31,7 +31,7 @@ import numpy as np
 
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxContactSurface, OsimxModel
-from nmsm.io.settings.gcp import ContactSurfaceSettings, GroundContactPersonalizationSettings
+from nmsm.io.settings.gcp import ContactSurfaceSettings, GroundContactPersonalizationSettings, surface_label
 from nmsm.io.storage import Table
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.components import Model
@@ -138,13 +138,23 @@ def matching_osimx_surface(osimx: OsimxModel | None, surface: ContactSurfaceSett
     return None
 
 
+def surface_foot_model(index: int, surface: ContactSurfaceSettings, model: Model,
+                       settings_file: Path | None) -> FootModel:
+    """The :class:`FootModel` of one surface; a body or marker the model lacks is an
+    :class:`InputError` at the surface's line of the settings file, naming the model."""
+    try:
+        return FootModel(model, surface.hindfoot_body, foot_markers(surface), surface.is_left_foot)
+    except InputError as exc:
+        raise InputError(f"{exc.detail} (model {model.file})", file=settings_file, line=surface.source.line,
+                         element=f"{surface_label(surface, index)}: {exc.element}", expected=exc.expected) from None
+
+
 def build_foot_inputs(index: int, surface: ContactSurfaceSettings, settings: GroundContactPersonalizationSettings,
                       model: Model, casadi_model: CasadiModel, motion: Table, grf: Table,
                       osimx: OsimxModel | None, *, spring_source: Path | None = None) -> FootInputs:
     """The :class:`FootInputs` of one enabled contact surface (foot ``index``, 1-based)."""
     settings_file = str(settings.settings_file) if settings.settings_file else None
-    foot = FootModel(model, surface.hindfoot_body, foot_markers(surface), surface.is_left_foot,
-                     settings_file=settings_file)
+    foot = surface_foot_model(index, surface, model, settings.settings_file)
     rows = window_indices(motion.time, surface.start_time, surface.end_time, file=settings.input_motion_file,
                           element=f"<GCPContactSurface> {surface.name or index}",
                           settings_file=settings.settings_file)
@@ -154,7 +164,7 @@ def build_foot_inputs(index: int, surface: ContactSurfaceSettings, settings: Gro
     reactions = foot_ground_reactions(
         grf, time, surface.force_columns, surface.moment_columns, surface.electrical_center_columns,
         grf_file=settings.input_grf_file, motion_file=settings.input_motion_file,
-        settings_file=settings.settings_file, line=surface.source.line)
+        settings_file=settings.settings_file, line=surface.source.line, surface=surface_label(surface, index))
     existing = matching_osimx_surface(osimx, surface)
     if existing is not None:
         springs = layout_from_osimx(existing.springs, foot, source=str(spring_source) if spring_source else None)

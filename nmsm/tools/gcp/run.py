@@ -7,17 +7,19 @@ reactions on its window); optionally initialize the resting spring length; run t
 tasks in index order, each starting from the previous solution; write the results
 (:mod:`nmsm.tools.gcp.outputs`) through a staged results folder and copy the settings file
 there. A stop (Ctrl-C) during task k+1 writes the results after task k, as the run would,
-into ``<results>/stopped_after_task_<k>/`` (with ``feet="separately"``: only when every
-group has a finished task; the earlier groups' results are after all their tasks) and
+into ``<results>/stopped_after_task_<k>/`` (with two feet solved separately: only when every
+foot has a finished task; the earlier feet's results are after all their tasks) and
 nothing else: an earlier complete run's files stay at the top; the next run retires the
 folder into ``superseded/`` with them.
 
 Options:
 
 ``results_directory``  override the settings' results folder (e.g. when it is read-only);
-``feet``               ``"together"`` (default, as the original: the feet share spring
-                       constants, damping, friction and resting length) or ``"separately"``
-                       (one problem per foot, each with its own properties);
+``feet``               ``"separately"`` (default: one problem per foot, each with its own
+                       spring constants, damping, friction and resting length; a foot's
+                       result is the one a settings file with that foot alone gives) or
+                       ``"together"`` (as the original: one problem in which the feet share
+                       those properties; docs/gcp.md "Both feet" compares the two);
 ``spring_locations``   an ``.osimx`` whose contact surfaces give the spring bodies and
                        locations (default: the settings' ``input_osimx_file`` when it has a
                        surface on the foot's hindfoot, else the marker-based grid of
@@ -177,7 +179,7 @@ def load_feet(settings: GroundContactPersonalizationSettings, *, spring_location
     return feet, casadi_model, motion, grf, osimx
 
 
-def run_settings(path: str | Path, *, results_directory: str | Path | None = None, feet: str = "together",
+def run_settings(path: str | Path, *, results_directory: str | Path | None = None, feet: str = "separately",
                  spring_locations: str | Path | None = None, max_iterations: int | None = None,
                  update_motion: bool = True, verbose: bool = False,
                  keep_finished_on_stop: bool = True) -> GcpRunResult:
