@@ -141,11 +141,12 @@ def matching_osimx_surface(osimx: OsimxModel | None, surface: ContactSurfaceSett
 def surface_foot_model(index: int, surface: ContactSurfaceSettings, model: Model,
                        settings_file: Path | None) -> FootModel:
     """The :class:`FootModel` of one surface; a body or marker the model lacks is an
-    :class:`InputError` at the surface's line of the settings file, naming the model."""
+    :class:`InputError` (:class:`ModelError` for the model's structure) at the surface's line of the
+    settings file, naming the model."""
     try:
         return FootModel(model, surface.hindfoot_body, foot_markers(surface), surface.is_left_foot)
     except InputError as exc:
-        raise InputError(f"{exc.detail} (model {model.file})", file=settings_file, line=surface.source.line,
+        raise type(exc)(f"{exc.detail} (model {model.file})", file=settings_file, line=surface.source.line,
                          element=f"{surface_label(surface, index)}: {exc.element}", expected=exc.expected) from None
 
 
