@@ -124,7 +124,7 @@ def surface_label(surface: ContactSurfaceSettings, index: int) -> str:
 def check_distinct_feet(surfaces: tuple[ContactSurfaceSettings, ...], settings_file: Path | None) -> None:
     """Each enabled surface is another foot: its own hindfoot body and its own force columns
     (two surfaces on one foot, or reading one plate, would fit one set of reactions twice)."""
-    first: dict[tuple[str, tuple[str, ...]], tuple[int, ContactSurfaceSettings]] = {}
+    first: dict[tuple[str, str | tuple[str, ...]], tuple[int, ContactSurfaceSettings]] = {}
     for index, surface in enumerate(surfaces, start=1):
         for element, key in (("hindfoot_body", surface.hindfoot_body), ("force_columns", surface.force_columns)):
             if not key:

@@ -192,16 +192,15 @@ def yxz_angles(rotation: np.ndarray) -> np.ndarray:
     return np.array([a, b, c])
 
 
-_SIDE_SWAPS = (("R_", "L_"), ("L_", "R_"), ("r_", "l_"), ("l_", "r_"))
+_SIDE_PREFIX_SWAPS = (("R_", "L_"), ("L_", "R_"), ("r_", "l_"), ("l_", "r_"))
+_SIDE_SUFFIX_SWAPS = (("_r", "_l"), ("_l", "_r"), ("_R", "_L"), ("_L", "_R"))
 
 
 def other_side_names(name: str) -> list[str]:
     """The other foot's spellings of a marker name (``R_Heel`` -> ``L_Heel``, ``heel_r`` ->
     ``heel_l``)."""
-    out = [other + name[len(side):] for side, other in _SIDE_SWAPS if name.startswith(side)]
-    out += [name[: -len(side)] + other for side, other in (("_r", "_l"), ("_l", "_r"), ("_R", "_L"), ("_L", "_R"))
-            if name.endswith(side)]
-    return out
+    out = [other + name[len(side):] for side, other in _SIDE_PREFIX_SWAPS if name.startswith(side)]
+    return out + [name[: -len(side)] + other for side, other in _SIDE_SUFFIX_SWAPS if name.endswith(side)]
 
 
 def foot_coordinates(rotation: np.ndarray, origin: np.ndarray, toe_angle: float, is_left: bool) -> np.ndarray:
