@@ -11,6 +11,11 @@ Settings files written on Windows use back-slashes and sometimes the wrong lette
 
 In each folder the exact spelling wins; otherwise each path component is matched
 case-insensitively (a warning names both spellings). Falling back to (2) or (3) warns too.
+Parts are followed one by one as the file system does: ``..`` is the parent of the folder
+reached so far (so a path may leave the settings file's folder), every part but the last must
+be a folder, and the last must be of the kind asked for (file or folder). An output path that
+does not exist yet continues below its longest existing part, matched the same way, so that a
+results folder lands inside ``Preprocessing`` when the settings say ``preprocessing``.
 A path that must exist and is found nowhere raises :class:`InputError` naming the settings
 file, line, element and every location tried.
 
@@ -30,6 +35,8 @@ import sys
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
+
+import attrs
 
 from nmsm.errors import InputError
 
@@ -87,36 +94,86 @@ def _kind_ok(path: Path, kind: str) -> bool:
     return path.exists()
 
 
-def match_case_insensitive(base: Path, relative: Path, kind: str = "any") -> Path | None:
-    """``base / relative`` with each missing component matched case-insensitively.
+@attrs.frozen
+class Walk:
+    """Where following a relative path's parts from a folder led.
 
-    Returns the existing path, or ``None``. Raises :class:`InputError` when a component
-    matches several entries that differ only in case.
+    ``path`` has no ``.`` or ``..`` parts; ``spelled`` is the relative path as spelled on disk
+    (``..`` parts kept); ``renamed`` is true when a part matched only case-insensitively;
+    ``complete`` is false when a part was missing (``path`` then ends with the parts as written).
     """
+
+    path: Path
+    spelled: str
+    renamed: bool
+    complete: bool
+
+
+def _entries(folder: Path, part: str, last: bool, kind: str) -> list[str]:
+    """Entries of ``folder`` spelled like ``part`` but for letter case, of the kind a path part needs."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    lowered = part.lower()
+    wanted = kind if last else "dir"
+    return sorted(n for n in names if n.lower() == lowered and _kind_ok(folder / n, wanted))
+
+
+def walk(base: Path, relative: Path, kind: str = "any", *, ignore_case: bool = True, partial: bool = False) -> Walk | None:
+    """Follow ``relative`` from the folder ``base`` part by part, as the file system does.
+
+    ``..`` goes to the parent of the folder reached so far (its real location, as the operating
+    system does after a symbolic link). A part that does not exist is matched case-insensitively
+    (``ignore_case``), among folders for every part but the last and among entries of ``kind``
+    for the last. Returns ``None`` when a part is missing, or, with ``partial``, a
+    :class:`Walk` whose path continues with the remaining parts as written. Raises
+    :class:`InputError` when a part matches several entries that differ only in case.
+    """
+    parts = [p for p in relative.parts if p not in ("", ".")]
     current = base
-    for part in relative.parts:
-        if part in ("", "."):
-            continue
+    spelled: list[str] = []
+    renamed = False
+    for position, part in enumerate(parts):
+        last = position == len(parts) - 1
         if part == "..":
-            current = current.parent
+            if not current.is_dir():
+                break
+            current = Path(os.path.realpath(current)).parent
+            spelled.append(part)
             continue
         exact = current / part
-        if exact.exists():
+        if _kind_ok(exact, kind if last else "dir"):
             current = exact
+            spelled.append(part)
             continue
-        if not current.is_dir():
-            return None
-        lowered = part.lower()
-        found = sorted(e for e in os.listdir(current) if e.lower() == lowered)
-        if not found:
-            return None
+        found = _entries(current, part, last, kind) if ignore_case and current.is_dir() else []
         if len(found) > 1:
             raise InputError(
                 f"'{part}' matches several entries of {current} that differ only in case: {', '.join(found)}",
                 expected="a path spelled exactly as on disk",
             )
+        if not found:
+            break
         current = current / found[0]
-    return current if _kind_ok(current, kind) else None
+        spelled.append(found[0])
+        renamed = True
+    else:
+        return Walk(current, "/".join(spelled), renamed, True)
+    if not partial:
+        return None
+    rest = parts[len(spelled):]
+    return Walk(Path(os.path.normpath(current.joinpath(*rest))), "/".join(spelled + rest), renamed, False)
+
+
+def match_case_insensitive(base: Path, relative: Path, kind: str = "any") -> Path | None:
+    """``base / relative`` with each missing component matched case-insensitively.
+
+    Returns the existing path (without ``..`` parts), or ``None``. Raises :class:`InputError`
+    when a component matches several entries that differ only in case.
+    """
+    found = walk(base, relative, kind)
+    return None if found is None else found.path
 
 
 def _describe(kind: str) -> str:
@@ -138,7 +195,7 @@ def resolve_path(
 
     ``base`` replaces the settings file's folder as the first place to look (e.g. GCP's
     ``input_directory``); with an explicit ``base`` no fallback folder is tried. With
-    ``must_exist=False`` a missing path resolves to ``base / text`` (outputs).
+    ``must_exist=False`` a missing path resolves below its longest existing part (outputs).
     ``on_fallback(text, found, where)`` replaces the warning issued when a path is found only
     relative to a fallback folder (a settings document warns once per file).
     """
@@ -170,31 +227,30 @@ def resolve_path(
         if folder in seen:
             continue
         seen.add(folder)
-        exact = folder / relative
-        tried.append(str(exact))
-        if _kind_ok(exact, kind):
-            if fallback:
-                _fallback(on_fallback, text, exact, fallback, settings_file, line, where)
-            return exact
+        tried.append(str(folder / relative))
         try:
-            found = match_case_insensitive(folder, relative, kind)
+            found = walk(folder, relative, kind)
         except InputError as exc:
             raise InputError(exc.detail, file=settings_file, line=line, element=where, expected=exc.expected) from None
         if found is not None:
-            warnings.warn(
-                f"{_loc(settings_file, line, where)}path '{text.strip()}' does not exist with this letter case; "
-                f"using '{found}' (spelled '{found.relative_to(folder)}' on disk)",
-                stacklevel=2,
-            )
+            if found.renamed:
+                _warn_case(text, found, settings_file, line, where)
             if fallback:
-                _fallback(on_fallback, text, found, fallback, settings_file, line, where)
-            return found
+                _fallback(on_fallback, text, found.path, fallback, settings_file, line, where)
+            return found.path
         if not must_exist:
             break
     if not must_exist:
         first = candidates[0][0]
-        first = first if first.is_absolute() else settings_dir / first
-        return (first / relative).resolve()
+        first = first.resolve() if first.is_absolute() else (settings_dir / first).resolve()
+        try:
+            output = walk(first, relative, "any", partial=True)
+        except InputError as exc:
+            raise InputError(exc.detail, file=settings_file, line=line, element=where, expected=exc.expected) from None
+        assert output is not None
+        if output.renamed:
+            _warn_case(text, output, settings_file, line, where)
+        return output.path
     if path.is_absolute():
         rule = ""
     elif base is not None:
@@ -208,6 +264,14 @@ def resolve_path(
         line=line,
         element=where,
         expected=_describe(kind) + rule,
+    )
+
+
+def _warn_case(text: str, found: Walk, settings_file: object, line: int | None, where: str | None) -> None:
+    warnings.warn(
+        f"{_loc(settings_file, line, where)}path '{text.strip()}' does not exist with this letter case; "
+        f"using '{found.path}' (spelled '{found.spelled}' on disk)",
+        stacklevel=4,
     )
 
 
