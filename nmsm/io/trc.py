@@ -10,7 +10,9 @@ Layout (tab separated)::
     [blank line]
     1  0.00  x y z  x y z ...
 
-Positions are converted to metres from ``Units`` (mm, cm, m). An empty or ``NaN`` entry is
+Empty cells of the header-key and header-value lines are dropped, as OpenSim drops them (its
+example files separate the values by two tabs). Positions are converted to metres from
+``Units`` (mm, cm, m). An empty or ``NaN`` entry is
 a gap (NaN), as OpenSim treats it: that marker is dropped for that frame. Extra trailing
 empty cells (written by spreadsheets) are ignored.
 """
@@ -165,6 +167,12 @@ def _cells(line: str) -> list[str]:
     return cells
 
 
+def _header_cells(line: str) -> list[str]:
+    """The non-empty cells of a header line: OpenSim drops empty ones, so that values separated
+    by two tabs (OpenSim's own example files) line up with their keys."""
+    return [c for c in (c.strip() for c in line.rstrip("\r\n").split("\t")) if c]
+
+
 def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
     """Parse the text of a ``.trc`` file (see :func:`read_trc`)."""
     lines = text.removeprefix(BOM).splitlines()
@@ -176,8 +184,15 @@ def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
             expected="a .trc file (PathFileType, header keys, header values, marker names, X/Y/Z labels, rows)",
         )
     first = _cells(lines[0])
-    keys = _cells(lines[1])
-    values = _cells(lines[2])
+    keys = _header_cells(lines[1])
+    values = _header_cells(lines[2])
+    if len(values) != len(keys):
+        raise InputError(
+            f"line 3 has {len(values)} values for the {len(keys)} keys of line 2",
+            file=source,
+            line=3,
+            expected="one value per key (" + " ".join(keys) + ")",
+        )
     header = dict(zip(keys, values))
     units = header.get("Units", "m").strip()
     units = UNIT_ALIASES.get(units, units)

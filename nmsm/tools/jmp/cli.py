@@ -2,9 +2,9 @@
 
     nmsm ik MODEL.osim MARKERS.trc [--ik-settings IK.xml] -o IK.mot [--errors ERRORS.sto]
 
-The IK settings (an OpenSim ``InverseKinematicsTool`` file) give marker weights, coordinate
-tasks, the time range and accuracy; MARKERS.trc may be omitted when they name the marker
-file. JMP itself runs through ``nmsm run JMPSettings.xml``.
+The IK settings (an OpenSim ``InverseKinematicsTool`` setup, or a bare ``IKTaskSet`` file)
+give marker weights, coordinate tasks, the time range and accuracy; MARKERS.trc may be
+omitted when a setup names the marker file. JMP itself runs through ``nmsm run JMPSettings.xml``.
 """
 
 from __future__ import annotations
@@ -75,7 +75,8 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser("ik", help="inverse kinematics of a .trc marker file (writes an OpenSim .mot)")
     p.add_argument("model", help="OpenSim model (.osim)")
     p.add_argument("markers", nargs="?", help="marker file (.trc); optional when --ik-settings names one")
-    p.add_argument("--ik-settings", help="OpenSim IK settings (.xml): marker weights, time range, accuracy")
+    p.add_argument("--ik-settings", help="OpenSim IK setup or IK task set (.xml): marker weights, coordinate tasks, "
+                   "time range, accuracy")
     p.add_argument("-o", "--output", help="output motion (.mot, rotational coordinates in degrees)")
     p.add_argument("--errors", help="also write per-marker distance errors (m) to this .sto")
     p.add_argument("--start", type=finite_float, help="first time (s)")

@@ -154,6 +154,7 @@ def inverse_kinematics(
     check_marker_units: bool = True,
     kinematics: MarkerKinematics | None = None,
     time_range_source: str | os.PathLike[str] | None = None,
+    weights_source: str | os.PathLike[str] | None = None,
 ) -> IkResult:
     """Inverse kinematics of a marker trial (see module docstring).
 
@@ -170,7 +171,10 @@ def inverse_kinematics(
     default pose). ``check_marker_units``: detect mm/m mix-ups (:func:`check_units`).
     ``kinematics``: a :class:`MarkerKinematics` already built for these markers (and
     parameters), to save building it again. ``time_range_source``: the settings file that
-    gave ``time_range`` (named when the range reaches beyond the markers).
+    gave ``time_range`` (named when the range reaches beyond the markers). ``weights_source``:
+    the IK settings file whose task set gave ``weights``; its tasks naming a marker that the
+    marker file or the model lacks are then skipped with a warning, as OpenSim's IK tool
+    skips them (without it such a marker is an :class:`InputError`).
     """
     if not isinstance(model, Model):
         model = load_model(model)
@@ -187,7 +191,10 @@ def inverse_kinematics(
     else:
         table = markers if isinstance(markers, MarkerTable) else read_trc(markers)
         trial = select_trial(table, model, weights, time_range=time_range,
-                             time_range_source=None if time_range_source is None else str(time_range_source))
+                             time_range_source=None if time_range_source is None else str(time_range_source),
+                             settings_file=None if weights_source is None else str(weights_source),
+                             element="<IKMarkerTask>" if weights_source is not None else "<marker_names>",
+                             skip_missing=weights_source is not None)
     task_names = [t.name for t in coordinate_tasks]
     if kinematics is not None:
         if kinematics.marker_names != tuple(trial.names) or not set(task_names) <= set(kinematics.free_names):
@@ -336,6 +343,7 @@ def run_ik_files(model_file: str | os.PathLike[str], marker_file: str | os.PathL
         time_range=time_range if time_range is not None else (settings.time_range if settings else None),
         accuracy=accuracy if accuracy is not None else (settings.accuracy if settings else None),
         time_range_source=settings.file if time_range is None and settings is not None else None,
+        weights_source=settings.file if settings is not None and settings.marker_weights is not None else None,
     )
     if output is not None:
         write_motion(output, result)

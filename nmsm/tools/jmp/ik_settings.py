@@ -1,4 +1,9 @@
-"""OpenSim inverse-kinematics settings files (``<OpenSimDocument><InverseKinematicsTool>``).
+"""OpenSim inverse-kinematics settings files, read as OpenSim's IK tool reads them.
+
+Accepted: an IK setup (``<OpenSimDocument><InverseKinematicsTool>``), whose ``<IKTaskSet>``
+may hold the tasks or name a task-set file (``<IKTaskSet file="tasks.xml"/>``, relative to
+the setup's folder), and a bare task set (``<OpenSimDocument><IKTaskSet>``, as OpenSim's
+examples ship marker weights), which gives only the tasks.
 
 Read: the IKTaskSet (``IKMarkerTask`` name/apply/weight, ``IKCoordinateTask``
 name/apply/weight/value_type/value), ``accuracy``, ``time_range``, ``marker_file``,
@@ -77,45 +82,82 @@ def _bool(path: Path, elem: etree._Element, text: str | None) -> bool:
     return value == "true"
 
 
-def read_ik_settings(path: str | os.PathLike[str]) -> IkSettings:
-    """Parse an OpenSim IK settings file (see module docstring)."""
-    path = Path(path)
+def _parse(path: Path) -> etree._Element:
     try:
-        root = etree.parse(str(path)).getroot()
+        return etree.parse(str(path)).getroot()
     except OSError as exc:
         raise InputError(f"cannot read the IK settings file ({exc})", file=path) from None
     except etree.XMLSyntaxError as exc:
         raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from None
-    tool = root if root.tag == "InverseKinematicsTool" else root.find("InverseKinematicsTool")
-    if tool is None:
-        raise InputError("no <InverseKinematicsTool> element", file=path, line=root.sourceline,
-                         expected="an OpenSim inverse-kinematics settings file")
+
+
+def _find(root: etree._Element, tag: str) -> etree._Element | None:
+    """``root`` itself, or its child, tagged ``tag``."""
+    return root if root.tag == tag else root.find(tag)
+
+
+def _task_set(path: Path, tool: etree._Element) -> tuple[Path, etree._Element | None]:
+    """The file and element holding the tool's tasks: its ``<IKTaskSet>``, or the task set of
+    the file that ``<IKTaskSet file="...">`` names."""
+    task_set = tool.find("IKTaskSet")
+    if task_set is None or not (task_set.get("file") or "").strip():
+        return path, task_set
+    reference = task_set.get("file", "").strip()
+    source = resolve_path(reference, settings_file=path, line=task_set.sourceline, element='IKTaskSet file="..."',
+                          kind="file")
+    found = _find(_parse(source), "IKTaskSet")
+    if found is None:
+        raise InputError(f"no <IKTaskSet> in {source}", file=path, line=task_set.sourceline,
+                         element='<IKTaskSet file="...">', expected="a file holding an OpenSim <IKTaskSet>")
+    return source, found
+
+
+def _tasks(path: Path, task_set: etree._Element | None) -> tuple[dict[str, float] | None, list[CoordinateTask]]:
+    """Marker weights (``None`` without tasks) and coordinate tasks of an ``<IKTaskSet>``."""
     weights: dict[str, float] | None = None
     coordinate_tasks: list[CoordinateTask] = []
-    task_set = tool.find("IKTaskSet")
-    if task_set is not None:
-        weights = {}
-        for task in task_set.iter("IKMarkerTask", "IKCoordinateTask"):
-            name = task.get("name")
-            if not name:
-                raise InputError(f"<{task.tag}> without a name", file=path, line=task.sourceline,
-                                 element=f"<{task.tag}>", expected='name="marker or coordinate"')
-            if not _bool(path, task, _text(task, "apply")):
-                continue
-            weight_text = _text(task, "weight")
-            weight = 1.0 if weight_text is None else _number(path, task, "weight", weight_text)
-            if task.tag == "IKMarkerTask":
-                weights[name] = weight
-                continue
-            value_type = (_text(task, "value_type") or "default_value").strip()
-            if value_type not in ("default_value", "manual_value", "from_file"):
-                raise InputError(f"<value_type> = '{value_type}'", file=path, line=task.sourceline,
-                                 element="<value_type>", expected="default_value, manual_value or from_file")
-            value_text = _text(task, "value")
-            value = 0.0 if value_text is None else _number(path, task, "value", value_text)
-            coordinate_tasks.append(CoordinateTask(name, weight, value_type, value))
-        if not weights and not coordinate_tasks:
-            weights = None
+    if task_set is None:
+        return weights, coordinate_tasks
+    weights = {}
+    for task in task_set.iter("IKMarkerTask", "IKCoordinateTask"):
+        name = task.get("name")
+        if not name:
+            raise InputError(f"<{task.tag}> without a name", file=path, line=task.sourceline,
+                             element=f"<{task.tag}>", expected='name="marker or coordinate"')
+        if not _bool(path, task, _text(task, "apply")):
+            continue
+        weight_text = _text(task, "weight")
+        weight = 1.0 if weight_text is None else _number(path, task, "weight", weight_text)
+        if task.tag == "IKMarkerTask":
+            weights[name] = weight
+            continue
+        value_type = (_text(task, "value_type") or "default_value").strip()
+        if value_type not in ("default_value", "manual_value", "from_file"):
+            raise InputError(f"<value_type> = '{value_type}'", file=path, line=task.sourceline,
+                             element="<value_type>", expected="default_value, manual_value or from_file")
+        value_text = _text(task, "value")
+        value = 0.0 if value_text is None else _number(path, task, "value", value_text)
+        coordinate_tasks.append(CoordinateTask(name, weight, value_type, value))
+    if not weights and not coordinate_tasks:
+        weights = None
+    return weights, coordinate_tasks
+
+
+def read_ik_settings(path: str | os.PathLike[str]) -> IkSettings:
+    """Parse an OpenSim IK setup or task-set file (see module docstring)."""
+    path = Path(path)
+    root = _parse(path)
+    tool = _find(root, "InverseKinematicsTool")
+    if tool is None:
+        task_set = _find(root, "IKTaskSet")
+        if task_set is None:
+            raise InputError(f"<{root.tag}> holds neither an <InverseKinematicsTool> nor an <IKTaskSet>", file=path,
+                             line=root.sourceline,
+                             expected="an OpenSim inverse-kinematics setup or IK task set "
+                                      "(<OpenSimDocument><InverseKinematicsTool> or <OpenSimDocument><IKTaskSet>)")
+        weights, coordinate_tasks = _tasks(path, task_set)
+        return IkSettings(file=path, marker_weights=weights, coordinate_tasks=tuple(coordinate_tasks))
+    weights, coordinate_tasks = _tasks(*_task_set(path, tool))
     accuracy_text = _text(tool, "accuracy")
     time_text = _text(tool, "time_range")
     time_range = None

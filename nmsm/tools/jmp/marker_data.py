@@ -67,12 +67,14 @@ def _where(table: MarkerTable) -> str | None:
 
 def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] | None = None, *,
                  time_range: tuple[float, float] | None = None, settings_file: str | None = None,
-                 element: str = "<marker_names>", time_range_source: str | None = None) -> MarkerTrial:
+                 element: str = "<marker_names>", time_range_source: str | None = None,
+                 skip_missing: bool = False) -> MarkerTrial:
     """The markers and frames used.
 
     ``weights`` (marker -> weight > 0) names the markers explicitly: each must be in the
     marker file and in the model, else :class:`InputError` naming ``settings_file`` and
-    ``element``. Without ``weights``, every marker of both the file and the model is used
+    ``element``; with ``skip_missing`` (an OpenSim IK task set, which OpenSim's IK tool reads
+    this way) such markers are left out with one warning naming them. Without ``weights``, every marker of both the file and the model is used
     with weight 1 (OpenSim's default). ``time_range`` (s, inclusive) selects frames; a
     finite end reaching more than half a frame beyond the marker data warns, naming
     ``time_range_source`` (default ``settings_file``), ``<time_range>``, the requested and
@@ -87,18 +89,31 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
         values = np.ones(len(names))
     else:
         names, values_list = [], []
+        skipped: dict[str, list[str]] = {}
         for name, weight in weights.items():
             if not weight > 0:
                 continue
+            absent = False
             for where, pool, what in ((_where(table), table.names, "marker file"),
                                       (model.file, model.marker_names, "model")):
-                if name not in pool:
-                    close = close_matches(name, list(pool))
-                    hint = f"; close matches: {', '.join(close)}" if close else ""
+                if name in pool:
+                    continue
+                close = ", ".join(close_matches(name, list(pool)))
+                if not skip_missing:
+                    hint = f"; close matches: {close}" if close else ""
                     raise InputError(f"marker '{name}' is not in the {what} {where}{hint}", file=settings_file or where,
                                      element=element, expected="markers present in both the marker file and the model")
+                skipped.setdefault(f"not in the {what} {where}", []).append(name + (f" (close: {close})" if close else ""))
+                absent = True
+                break
+            if absent:
+                continue
             names.append(name)
             values_list.append(float(weight))
+        if skipped:
+            where = f"{settings_file}: " if settings_file else ""
+            reasons = "; ".join(f"{why}: {_few(found)}" for why, found in skipped.items())
+            warnings.warn(f"{where}{element} task(s) skipped, as OpenSim's IK tool skips them: {reasons}", stacklevel=2)
         if not names:
             raise InputError("no marker has a positive weight", file=settings_file, element=element,
                              expected="at least one marker with weight > 0")
