@@ -462,6 +462,7 @@ def read_settings_document(
     ``check_paths=False`` resolves paths without requiring them to exist (templates,
     upgrade previews).
     """
+    from nmsm.io.settings import upgrade_released
     from nmsm.io.settings.upgrade import detect_schema, upgrade_tree
 
     path = Path(path)
@@ -487,6 +488,11 @@ def read_settings_document(
             warnings.warn(f"{path}: {note}", stacklevel=2)
         root = result.root
         upgraded_from = schema
+    elif upgrade and root.tag == ROOT and upgrade_released.needed(root):
+        result = upgrade_tree(root, path)
+        for note in result.notes:
+            warnings.warn(f"{path}: {note}", stacklevel=2)
+        root = result.root
     if root.tag != ROOT:
         inner = next(iter(elements(root)), None)
         use = OPENSIM_TOOL_FILES.get(str(inner.tag)) if root.tag == "OpenSimDocument" and inner is not None else None

@@ -102,11 +102,12 @@ class ContactSurfaceSettings:
     @classmethod
     def validate(cls, values: dict[str, Any], ctx: ReadContext) -> None:
         for old in ("toes_coordinate", "toe_coordinate", "toes_joint", "toe_joint"):
-            if ctx.child(old) is not None:
+            if ctx.child(old) is not None:  # left by the upgrade only when the model could not be read
                 raise ctx.error(
                     old,
-                    f"<{old}> is from the old GCP schema",
-                    "<hindfoot_body> naming the hindfoot body (run 'nmsm upgrade-settings' on OpenSimDocument files)",
+                    f"<{old}> (NMSM Pipeline 1.0) names the toe joint, and the input model that gives its parent "
+                    "body could not be read",
+                    "<hindfoot_body> naming the hindfoot body, or a readable <input_model_file>",
                 )
         if not values["start_time"] < values["end_time"]:
             raise ctx.error(

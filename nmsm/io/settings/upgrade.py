@@ -2,7 +2,9 @@
 
 Schemas recognized (:func:`detect_schema`):
 
-``current``        ``<NMSMPipelineDocument Version="1.x">`` + tool element.
+``current``        ``<NMSMPipelineDocument Version="1.x">`` + tool element; elements that an
+                   earlier 1.x release wrote and the current schema replaced are translated
+                   (:mod:`nmsm.io.settings.upgrade_released`).
 ``opensim-2023``   root ``<OpenSimDocument>`` (2021-2023 nmsm-core settings: JMP, MTP, NCP,
                    GCP), with OpenSim-style ``<objects>``/``<groups>`` set wrappers.
 ``treatment-0.1``  ``<NMSMPipelineDocument Version="0.x">`` TO/VO/DO files (jerk controls,
@@ -155,13 +157,17 @@ def detect_schema(root: etree._Element) -> str:
 
 def upgrade_tree(root: etree._Element, path: str | os.PathLike[str]) -> UpgradeResult:
     """Upgrade a parsed settings root (a copy; ``root`` is untouched)."""
-    from nmsm.io.settings import upgrade_legacy_personalization, upgrade_legacy_treatment
+    from nmsm.io.settings import upgrade_legacy_personalization, upgrade_legacy_treatment, upgrade_released
 
     path = Path(path)
     schema = detect_schema(root)
     work = copy.deepcopy(root)
     if schema == "current":
-        return UpgradeResult(work, schema)
+        if work.tag != ROOT or not upgrade_released.needed(work):
+            return UpgradeResult(work, schema)
+        released = Upgrader(work, path, schema)
+        upgrade_released.upgrade(released)
+        return UpgradeResult(released.root, schema, released.notes)
     found = list(elements(root))
     if schema in ("opensim-2023", "treatment-0.1") and len(found) > 1:  # the upgrade would read the first only
         raise InputError(
