@@ -109,3 +109,26 @@ def test_upgrade_settings_writes_the_hindfoot_body(shared_data: Path, tmp_path: 
     surface = etree.parse(str(out)).getroot().find(".//GCPContactSurface")
     assert surface.findtext("hindfoot_body") == "calcn_r"
     assert surface.find("toe_joint") is None and surface.find("toe_coordinate") is None
+
+
+@pytest.mark.shared_data
+def test_an_element_without_effect_is_named_once(shared_data: Path, tmp_path: Path) -> None:
+    """The 1.1.0 tutorial's MTP settings carry <MTPSynergyExtrapolation><task_prefixes>, which the
+    current original does not read: one warning naming it and its release (it was an "unknown
+    element" warning)."""
+    source = shared_data / "mtp" / "uf_subject3_tutorial"
+    for name in ("preprocessed", "passive_moment_data"):
+        (tmp_path / name).symlink_to(source / name, target_is_directory=True)
+    (tmp_path / "UF_Subject_3_reduced_muscles.osim").symlink_to(source / "UF_Subject_3_reduced_muscles.osim")
+    tree = etree.parse(str(source / "CompletedSettingsFiles" / "MTPSettingsV1.xml"))
+    tree.getroot().set("Version", "1.1.0")
+    synx = tree.getroot().find("MuscleTendonPersonalizationTool/MTPSynergyExtrapolation")
+    prefixes = etree.SubElement(synx, "task_prefixes")
+    prefixes.text = "gait_1"
+    path = tmp_path / "MTPSettings.xml"
+    tree.write(str(path))
+    settings, messages = _read(path)
+    assert settings.synergy_extrapolation is not None
+    about = [m for m in messages if "task_prefixes" in m]
+    assert len(about) == 1, about
+    assert "written by NMSM Pipeline 1.1" in about[0] and "no effect" in about[0] and "unknown" not in about[0]

@@ -11,6 +11,10 @@ the joint must exist, the coordinate must belong to it, and the joint's parent b
 hindfoot body; a ``<hindfoot_body>`` naming another body is an :class:`InputError` (the file
 contradicts itself), a missing one is added. The old elements are then replaced by comments,
 with one note per element name.
+
+Elements that a 1.x release wrote and the current original no longer reads (:data:`UNUSED`)
+are replaced by comments with one note per element name (not one "unknown element" warning
+per occurrence).
 """
 
 from __future__ import annotations
@@ -22,18 +26,52 @@ from nmsm.io.settings.document import elements
 from nmsm.io.settings.upgrade import Upgrader, child_of
 from nmsm.io.settings.upgrade_legacy_personalization import _first_child, _last, _read_model
 
+#: (tool element, parent element, element) -> the releases that wrote it; the current original
+#: does not read it, so it has no effect
+UNUSED: dict[tuple[str, str, str], str] = {
+    ("MuscleTendonPersonalizationTool", "MTPSynergyExtrapolation", "task_prefixes"): "1.1",
+}
+_TOE_TAGS = ("toe_joint", "toes_joint", "toe_coordinate", "toes_coordinate")
+
+
+def _unused(tool: etree._Element) -> list[etree._Element]:
+    """Elements of ``tool`` listed in :data:`UNUSED`."""
+    return [e for (tool_tag, parent, tag) in UNUSED if tool.tag == tool_tag
+            for e in tool.iter(tag) if e.getparent() is not None and e.getparent().tag == parent]
+
+
 def needed(root: etree._Element) -> bool:
     """Whether ``root`` holds an element that :func:`upgrade` translates."""
     tool = next(elements(root), None)
-    return tool is not None and tool.tag == "GroundContactPersonalizationTool" and any(
-        True for _ in tool.iter("toe_joint", "toes_joint", "toe_coordinate", "toes_coordinate"))
+    if tool is None:
+        return False
+    toes = tool.tag == "GroundContactPersonalizationTool" and any(True for _ in tool.iter(*_TOE_TAGS))
+    return toes or bool(_unused(tool))
 
 
 def upgrade(up: Upgrader) -> None:
     """Translate the elements of earlier 1.x releases in ``up.root`` (see module docstring)."""
     tool = next(elements(up.root), None)
-    if tool is not None and tool.tag == "GroundContactPersonalizationTool":
+    if tool is None:
+        return
+    if tool.tag == "GroundContactPersonalizationTool":
         _gcp_toe_elements(up, tool)
+    _drop_unused(up, tool)
+
+
+def _drop_unused(up: Upgrader, tool: etree._Element) -> None:
+    """Elements without effect replaced by comments, one note per element name."""
+    version = up.root.get("Version", "?")
+    found: dict[tuple[str, str], list[etree._Element]] = {}
+    for element in _unused(tool):
+        found.setdefault((str(element.getparent().tag), str(element.tag)), []).append(element)
+    for (parent, tag), dropped in found.items():
+        releases = UNUSED[(str(tool.tag), parent, tag)]
+        for element in dropped:
+            _replace(up, element, "no effect in NMSM Pipeline 1.5")
+        lines = ", ".join(str(e.sourceline) for e in dropped)
+        up.notes.append(f"<{tag}> in <{parent}> (line {lines}; written by NMSM Pipeline {releases}, this file says "
+                        f'Version="{version}") has no effect in NMSM Pipeline 1.5 or nmsm: ignored')
 
 
 def _joints(model: etree._Element) -> list[etree._Element]:
@@ -91,7 +129,7 @@ def _gcp_toe_elements(up: Upgrader, tool: etree._Element) -> None:
             hindfoot.text = body
         for element in old:
             checked.setdefault(str(element.tag), []).append(f"{(element.text or '').strip()} -> {body}")
-            _replace(up, element)
+            _replace(up, element, "read as <hindfoot_body> (the toe joint's parent body)")
     for tag, found in checked.items():
         up.notes.append(
             f"<{tag}> (written by NMSM Pipeline 1.0; this file says Version=\"{version}\") checked against the model "
@@ -99,10 +137,10 @@ def _gcp_toe_elements(up: Upgrader, tool: etree._Element) -> None:
         )
 
 
-def _replace(up: Upgrader, element: etree._Element) -> None:
-    """``element`` replaced by a comment quoting it, without a note of its own."""
+def _replace(up: Upgrader, element: etree._Element, why: str) -> None:
+    """``element`` replaced by a comment quoting it (saying ``why``), without a note of its own."""
     notes = len(up.notes)
-    up.drop(element, "read as <hindfoot_body> (the toe joint's parent body)")
+    up.drop(element, why)
     del up.notes[notes:]
 
 
