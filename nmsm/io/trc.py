@@ -11,7 +11,9 @@ Layout (tab separated)::
     1  0.00  x y z  x y z ...
 
 Empty cells of the header-key and header-value lines are dropped, as OpenSim drops them (its
-example files separate the values by two tabs). Positions are converted to metres from
+example files separate the values by two tabs). Marker names are taken in order; names not
+three columns apart (one tab between them) are read as OpenSim reads them when their count
+is ``NumMarkers``, and are an error otherwise (a name is then likely missing). Positions are converted to metres from
 ``Units`` (mm, cm, m). An empty or ``NaN`` entry is
 a gap (NaN), as OpenSim treats it: that marker is dropped for that frame. Extra trailing
 empty cells (written by spreadsheets) are ignored.
@@ -214,8 +216,9 @@ def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
         )
     names = [c for c in name_cells[2:] if c]
     positions_of_names = [j for j, c in enumerate(name_cells) if j >= 2 and c]
+    declared = _int_or_none(header.get("NumMarkers", ""))
     for k, j in enumerate(positions_of_names):
-        if j != 2 + 3 * k:
+        if j != 2 + 3 * k and declared != len(names):  # OpenSim takes the names in order when NumMarkers agrees
             raise InputError(
                 f"marker '{name_cells[j]}' is in column {j + 1}; names must be 3 columns apart",
                 file=source,
@@ -228,7 +231,6 @@ def parse_trc(text: str, *, source: Path | None = None) -> MarkerTable:
         raise InputError(
             f"duplicated marker name(s): {', '.join(duplicated)}", file=source, line=4, expected="unique marker names"
         )
-    declared = _int_or_none(header.get("NumMarkers", ""))
     if declared is not None and declared != len(names):
         warnings.warn(
             f"{source}: NumMarkers={declared} but line 4 names {len(names)} markers; using the names", stacklevel=3

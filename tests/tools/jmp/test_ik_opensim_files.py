@@ -75,6 +75,25 @@ def test_trc_header_with_a_value_missing_is_refused(shared_data: Path, tmp_path:
     assert info.value.line == 3
 
 
+@pytest.mark.shared_data
+def test_trc_marker_names_one_tab_apart(shared_data: Path, tmp_path: Path) -> None:
+    """Names separated by one tab (OpenSim 4.6 reads them in order: its TRCFileAdapter drops the
+    empty cells of that line) read as the original; with a name missing they do not line up with
+    NumMarkers and stay an error."""
+    lines = (shared_data / WALK / "walk_free_01.trc").read_text().split("\n")
+    names = [c for c in lines[3].split("\t")[2:] if c.strip()]
+    lines[3] = "\t".join(["Frame#", "Time", *names])
+    path = tmp_path / "one_tab.trc"
+    path.write_text("\n".join(lines))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # NumFrames 900 for 73 rows, in both files
+        assert read_trc(path) == read_trc(shared_data / WALK / "walk_free_01.trc")
+    lines[3] = "\t".join(["Frame#", "Time", *names[1:]])
+    path.write_text("\n".join(lines))
+    with pytest.raises(InputError, match="names must be 3 columns apart"):
+        read_trc(path)
+
+
 # ----- IK task sets -----------------------------------------------------------------------------
 @pytest.mark.shared_data
 def test_bare_task_set_gives_the_setups_tasks(shared_data: Path, tmp_path: Path) -> None:
