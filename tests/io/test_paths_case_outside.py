@@ -176,3 +176,14 @@ def test_output_spelled_exactly_does_not_warn(study: Path) -> None:
         warnings.simplefilter("error")
         found = resolve_path("../Preprocessing/new/../results", settings_file=settings, must_exist=False)
     assert found == study / "Preprocessing" / "results"
+
+
+# ----- an explicit base folder (GCP's <input_directory>) ----------------------------------------
+def test_explicit_base_with_dot_dot_and_wrong_case(study: Path) -> None:
+    settings = study / "TrackingOptimization" / "to.xml"
+    base = study / "Preprocessing" / "preprocessed"
+    with pytest.warns(UserWarning, match="spelled '../../Models/Subject.osim' on disk"):
+        found = resolve_path("..\\..\\models\\SUBJECT.osim", settings_file=settings, base=base, kind="file")
+    assert found == study / "Models" / "Subject.osim"
+    with pytest.raises(InputError, match=r"relative paths are relative to"):
+        resolve_path("..\\models\\SUBJECT.osim", settings_file=settings, base=base, kind="file")
