@@ -12,7 +12,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.settings import GroundContactPersonalizationSettings, read_settings_document, read_tool_settings
-from nmsm.io.settings.upgrade import upgrade_settings_file
+from nmsm.cli import main
 
 TUTORIAL = "gcp/uf_subject3_tutorial"
 
@@ -100,12 +100,13 @@ def test_toe_elements_contradicting_the_model_or_the_file_are_refused(shared_dat
 
 
 @pytest.mark.shared_data
-def test_upgrade_settings_writes_the_hindfoot_body(shared_data: Path, tmp_path: Path) -> None:
+def test_upgrade_settings_writes_the_hindfoot_body(shared_data: Path, tmp_path: Path, capsys) -> None:
     path = released_gcp(shared_data, tmp_path, "1.0.0", _as_1_0)
     out = path.with_name("GCPSettings_upgraded.xml")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        upgrade_settings_file(path, out)
+    assert main(["upgrade-settings", str(path), "-o", str(out)]) == 0
+    printed = capsys.readouterr().err
+    assert "elements of an earlier 1.x release -> current" in printed and "<toe_joint>" in printed
+    assert "earlier 1.x release translated" in out.read_text().splitlines()[0]
     surface = etree.parse(str(out)).getroot().find(".//GCPContactSurface")
     assert surface.findtext("hindfoot_body") == "calcn_r"
     assert surface.find("toe_joint") is None and surface.find("toe_coordinate") is None

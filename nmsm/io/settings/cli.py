@@ -39,10 +39,11 @@ def _upgrade_settings(args: argparse.Namespace) -> int:
 
     replaced = " (replaced the existing file: --force)" if Path(args.output).is_file() else ""
     result = upgrade_settings_file(args.old, args.output, force=args.force)
-    if result.schema == "current":
+    if result.schema == "current" and not result.notes:
         print(f"{args.old} already uses the current schema; copied to {args.output}{replaced}", file=sys.stderr)
         return 0
-    print(f"{args.old}: schema {result.schema} -> current; wrote {args.output}{replaced}", file=sys.stderr)
+    source = "elements of an earlier 1.x release" if result.schema == "current" else f"schema {result.schema}"
+    print(f"{args.old}: {source} -> current; wrote {args.output}{replaced}", file=sys.stderr)
     for note in result.notes:
         print(f"  {note}", file=sys.stderr)
     return 0

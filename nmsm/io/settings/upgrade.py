@@ -297,7 +297,10 @@ def upgrade_settings_file(
     tree = result.root
     etree.indent(tree, space="\t")
     header = f"<!-- Upgraded by nmsm upgrade-settings from {source.name} (schema {result.schema}). -->\n"
-    if result.schema == "current":
+    if result.schema == "current" and result.notes:
+        header = (f"<!-- Upgraded by nmsm upgrade-settings from {source.name} (elements of an earlier 1.x release "
+                  "translated). -->\n")
+    elif result.schema == "current":
         header = f"<!-- {source.name} already uses the current schema; copied by nmsm upgrade-settings. -->\n"
     text = etree.tostring(tree, encoding="unicode")
     write_output(destination, header + text + "\n")
