@@ -120,7 +120,9 @@ def _entries(folder: Path, part: str, last: bool, kind: str) -> list[str]:
     return sorted(n for n in names if n.lower() == lowered and _kind_ok(folder / n, wanted))
 
 
-def walk(base: Path, relative: Path, kind: str = "any", *, ignore_case: bool = True, partial: bool = False) -> Walk | None:
+def walk(
+    base: Path, relative: Path, kind: str = "any", *, ignore_case: bool = True, partial: bool = False
+) -> Walk | None:
     """Follow ``relative`` from the folder ``base`` part by part, as the file system does.
 
     ``..`` goes to the parent of the folder reached so far (its real location, as the operating

@@ -72,7 +72,8 @@ def test_mtp_settings_naming_a_sibling_folder_in_another_case(shared_data: Path,
 
 # ----- ".." parts ---------------------------------------------------------------------------------
 @pytest.mark.parametrize("text", ["..\\preprocessing\\preprocessed", "../PREPROCESSING/Preprocessed/",
-                                  "..\\\\preprocessing\\.\\preprocessed", "../TrackingOptimization/../preprocessing/preprocessed"])
+                                  "..\\\\preprocessing\\.\\preprocessed",
+                                  "../TrackingOptimization/../preprocessing/preprocessed"])
 def test_dot_dot_then_wrong_case(study: Path, text: str) -> None:
     settings = study / "TrackingOptimization" / "to.xml"
     with pytest.warns(UserWarning, match="on disk") as record:

@@ -103,7 +103,8 @@ def select_trial(table: MarkerTable, model: Model, weights: Mapping[str, float] 
                     hint = f"; close matches: {close}" if close else ""
                     raise InputError(f"marker '{name}' is not in the {what} {where}{hint}", file=settings_file or where,
                                      element=element, expected="markers present in both the marker file and the model")
-                skipped.setdefault(f"not in the {what} {where}", []).append(name + (f" (close: {close})" if close else ""))
+                shown = name + (f" (close: {close})" if close else "")
+                skipped.setdefault(f"not in the {what} {where}", []).append(shown)
                 absent = True
                 break
             if absent:

@@ -159,7 +159,8 @@ def test_tasks_naming_absent_markers_are_skipped_as_opensim_does(shared_data: Pa
         ours = run_ik_files(model_file, ik_settings=settings, time_range=WINDOW, accuracy=1e-10)
     skipped = [str(w.message) for w in record if "skipped" in str(w.message)]
     assert len(skipped) == 1 and str(setup) in skipped[0]
-    assert re.search(r"not in the marker file [^:]*walk_2tabs.trc: R.HeelGround \(close: R.Heel\), R.Knee.Lat", skipped[0])
+    assert re.search(r"not in the marker file [^:]*walk_2tabs.trc: R.HeelGround \(close: R.Heel\), R.Knee.Lat",
+                     skipped[0])
     assert "not in the model" in skipped[0] and "R.Elbow" in skipped[0]
     assert set(ours.marker_names) == {n for n, w in settings.marker_weights.items() if w > 0} - set(EXTRA_TASKS)
     theirs = bridge.call("opensim_inverse_kinematics", model=str(model_file), marker_file=str(trc),
