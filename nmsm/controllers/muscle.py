@@ -45,6 +45,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core.plugin_bases import ControlSpec, Controller, StateSpec
+from nmsm.interop.moco_trajectory import MocoColumns, muscle_activation_path, muscle_control_path
 from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
 from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
 
@@ -309,6 +310,13 @@ class MuscleActivationController(Controller):
         excitations = np.hstack([solution.control(EXCITATION_PREFIX + m) for m in self.muscles])
         return {f"{solution.trial_name}_combinedActivations.sto": (self.muscles, activations),
                 f"{solution.trial_name}_muscleExcitations.sto": (self.muscles, excitations)}
+
+    def moco_columns(self, solution: Any) -> MocoColumns:
+        if not self.activation_dynamics:
+            return MocoColumns(controls={muscle_control_path(m): solution.control(PREFIX + m) for m in self.muscles})
+        return MocoColumns(
+            states={muscle_activation_path(m): solution.controller_state(PREFIX + m) for m in self.muscles},
+            controls={muscle_control_path(m): solution.control(EXCITATION_PREFIX + m) for m in self.muscles})
 
 
 def _time_constants(settings: Any, model: Any, osimx: Any, muscle: str, where: Any) -> tuple[float, float]:

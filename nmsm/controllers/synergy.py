@@ -35,6 +35,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core.plugin_bases import ControlSpec, Controller
+from nmsm.interop.moco_trajectory import MocoColumns, muscle_control_path
 from nmsm.io.storage import Table
 from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
 from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
@@ -288,3 +289,7 @@ class SynergyController(Controller):
             "synergyWeights.sto": (self.muscles, weights_n, np.arange(1.0, weights_n.shape[0] + 1)),
             f"{trial}_combinedActivations.sto": (self.muscles, activations),
         }
+
+    def moco_columns(self, solution: Any) -> MocoColumns:
+        activations = self.output_tables(solution)[f"{solution.trial_name}_combinedActivations.sto"][1]
+        return MocoColumns(controls={muscle_control_path(m): activations[:, j] for j, m in enumerate(self.muscles)})

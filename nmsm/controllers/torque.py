@@ -22,6 +22,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from nmsm.core.plugin_bases import ControlSpec, Controller
+from nmsm.interop.moco_trajectory import MocoColumns, torque_actuator_path
 from nmsm.tools.treatment.bounds import RangeRule, range_bounds
 from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
 
@@ -121,3 +122,6 @@ class TorqueController(Controller):
     def output_tables(self, solution: Any) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:
         values = np.hstack([solution.control(PREFIX + c) for c in self.coordinates])
         return {f"{solution.trial_name}_torqueControls.sto": (self.coordinates, values)}
+
+    def moco_columns(self, solution: Any) -> MocoColumns:
+        return MocoColumns(controls={torque_actuator_path(c): solution.control(PREFIX + c) for c in self.coordinates})

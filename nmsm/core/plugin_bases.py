@@ -149,6 +149,12 @@ class Controller:
         ``solution`` is a :class:`nmsm.tools.treatment.solution.TreatmentSolution`."""
         return {}
 
+    def moco_columns(self, solution: Any) -> Any:
+        """This controller's states and controls named by OpenSim component path, as a
+        :class:`nmsm.interop.moco_trajectory.MocoColumns` on the output grid (the Moco
+        trajectory file); None when it has none to write."""
+        return None
+
 
 class ContactModel:
     """Ground contact in Treatment Optimization: loads on bodies from the kinematics.

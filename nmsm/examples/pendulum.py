@@ -48,6 +48,9 @@ class Pendulum:
     def is_rotational(self, coordinate: str) -> bool:
         return True
 
+    def coordinate_joint(self, coordinate: str) -> str:
+        return "follower_joint" if coordinate == "follower" else f"joint_{coordinate[1:]}"
+
     def load_label(self, coordinate: str) -> str:
         return f"{coordinate}_moment"
 

@@ -65,6 +65,9 @@ class OsimTreatmentModel:
     def is_rotational(self, coordinate: str) -> bool:
         return self._rotational[coordinate]
 
+    def coordinate_joint(self, coordinate: str) -> str:
+        return self.model.coordinate(coordinate).joint
+
     def load_label(self, coordinate: str) -> str:
         return f"{coordinate}_moment" if self._rotational[coordinate] else f"{coordinate}_force"
 

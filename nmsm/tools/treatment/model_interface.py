@@ -29,6 +29,9 @@ class TreatmentModel(Protocol):
     def is_rotational(self, coordinate: str) -> bool:
         """True for rotational coordinates (rad), False for translational ones (m)."""
 
+    def coordinate_joint(self, coordinate: str) -> str:
+        """The name of the joint holding ``coordinate`` (its state paths: ``/jointset/<joint>/<coordinate>/value``)."""
+
     def load_label(self, coordinate: str) -> str:
         """The inverse-dynamics column label: ``<coordinate>_moment`` or ``<coordinate>_force``."""
 

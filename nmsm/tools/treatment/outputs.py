@@ -8,6 +8,9 @@ Files (``<trial>`` = ``trial_name``):
                                        point m, moment N·m about the point; osimx column names)
 ``<trial>_states.sto``                 ``q`` and ``q_u`` of the state coordinates
 ``<trial>_accelerations.sto``          ``q̈`` of the state coordinates
+``<trial>_mocoTrajectory.sto``         the states and the controllers' controls named by OpenSim
+                                       component path, with Moco's header counts: opens as
+                                       ``opensim.MocoTrajectory(path)`` (:mod:`nmsm.interop.moco_trajectory`)
 ``<trial>_torqueControls.sto`` ...     each controller's tables (torque controls, synergy
                                        commands, synergy weights, combined activations)
 ``<trial>_parameterSolution.xml``      DO static parameters (when any)
@@ -23,6 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
+from nmsm.interop.moco_trajectory import (
+    MocoColumns,
+    coordinate_speed_path,
+    coordinate_value_path,
+    write_moco_trajectory,
+)
 from nmsm.io.storage import table_from_columns, write_storage
 from nmsm.tools.treatment.formulation import speed_label
 from nmsm.tools.treatment.solution import TreatmentSolution
@@ -71,6 +80,7 @@ def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None 
         else:
             time = t if values.shape[0] == t.size else np.arange(1.0, values.shape[0] + 1)
         out.append(write_table(stage / name, time, labels, values))
+    out.append(write_moco_trajectory(stage / f"{trial}_mocoTrajectory.sto", t, moco_columns(tsol), name=trial))
     # tracked vs modeled kinematics of the states, on the same times
     ref_t = tsol.view.normalized_time * data.reference_duration
     tracked = data.tracked_full_kinematics(ref_t)
@@ -84,3 +94,21 @@ def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None 
         path.write_text(summary + "\n", encoding="utf-8")
         out.append(path)
     return out
+
+
+def moco_columns(tsol: TreatmentSolution) -> MocoColumns:
+    """The solution's Moco trajectory columns: each state coordinate's value and speed, then
+    every controller's own states and controls (:meth:`Controller.moco_columns`)."""
+    data = tsol.built.data
+    sc = list(data.state_coordinates)
+    columns = MocoColumns()
+    joints = {c: data.model.coordinate_joint(c) for c in sc}
+    for j, c in enumerate(sc):
+        columns.states[coordinate_value_path(joints[c], c)] = tsol.states[:, j]
+    for j, c in enumerate(sc):
+        columns.states[coordinate_speed_path(joints[c], c)] = tsol.states[:, len(sc) + j]
+    for controller in data.controllers:
+        extra = controller.moco_columns(tsol)
+        if extra is not None:
+            columns.update(extra)
+    return columns
