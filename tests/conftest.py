@@ -5,6 +5,9 @@
                  (set by ``.ci/run``).
 ``bridge``       the OpenSim worker; skips when ``opensim`` is not installed, fails instead
                  when ``NMSM_REQUIRE_OPENSIM=1``.
+``chromium``     the path of a headless Chromium (``chromium``, ``chromium-browser`` or
+                 ``google-chrome``); skips when there is none, fails instead when
+                 ``NMSM_REQUIRE_BROWSER=1`` (set by ``.ci/run``).
 ``default_sigint`` Python's own SIGINT handler for the test (restored after): a pytest started
                  in the background of a non-interactive shell (``nohup pytest ... &``) inherits
                  SIGINT ignored, and tests of Ctrl-C need the handler an interactive run has.
@@ -55,6 +58,19 @@ def shared_data() -> Path:
             pytest.fail(message + "; NMSM_REQUIRE_SHARED_DATA is set, so this is an error")
         pytest.skip(message)
     return path
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    import shutil
+
+    found = next((path for path in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if path), None)
+    if found is None:
+        message = "no headless Chromium on PATH (Debian: apt-get install chromium)"
+        if _require("NMSM_REQUIRE_BROWSER"):
+            pytest.fail(message + "; NMSM_REQUIRE_BROWSER is set, so this is an error")
+        pytest.skip(message)
+    return found
 
 
 @pytest.fixture(scope="session")

@@ -1,74 +1,106 @@
-"""``nmsm report RESULTS_DIR``: one HTML page with every stage's tables and figures.
+"""``nmsm report RESULTS_DIR``: one HTML page with every stage's status, figures and tables.
 
 The stages of a pipeline results tree come from its ``pipeline_state.json`` (in pipeline
 order, with each stage's kind and time); any other folder is searched for tool results
-folders (:func:`nmsm.plots.cli.results_folders`). For each stage: its tables
-(:mod:`nmsm.report.tables`) and its figures, embedded as base64 PNG so the page is one file
-that can be mailed: the PNGs of ``<stage>/plots`` when there are any (``nmsm plot``),
-otherwise drawn by the tool's plot module into a temporary folder that is removed once the
-page is built. The report reads the results tree and never writes into it (the page itself
-goes where it is told, by default ``<results>/report.html``). The example adds its
-known-answer comparison on top.
+folders (:func:`nmsm.plots.cli.results_folders`). The page leads with a status table (one
+row per stage: converged or not, solver statuses, headline errors, time;
+:mod:`nmsm.report.status`) linking to each stage's section; a section shows the stage's
+figures, then its tables (:mod:`nmsm.report.tables`) and summaries collapsed. Figures are
+embedded as base64 PNG so the page is one file that can be mailed: the PNGs of
+``<stage>/plots`` when there are any (``nmsm plot``), otherwise drawn by the tool's plot
+module into a temporary folder that is removed once the page is built. The report reads
+the results tree and never writes into it (the page itself goes where it is told, by
+default ``<results>/report.html``). The example adds its known-answer comparison (collapsed,
+under the status table).
+
+The page is rendered with Jinja2 from the templates in ``nmsm/report/templates``:
+``report.html.j2`` (the page), ``status.html.j2``, ``checks.html.j2``, ``table.html.j2``
+and ``stage.html.j2`` (a stage's section). A kind of stage gets its own section by adding
+``stages/<kind>.html.j2`` (usually ``{% extends "stage.html.j2" %}`` overriding a block),
+its tables by an entry in :data:`nmsm.report.tables.BUILDERS` and its status row by one in
+:data:`nmsm.report.status.STATUS_READERS`.
 """
 
 from __future__ import annotations
 
 import base64
 import datetime
-import html
 import json
 import os
+import re
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
+
+import attrs
 
 from nmsm.errors import InputError
 from nmsm.io.output_file import write_output
-from nmsm.report.tables import BUILDERS, ReportTable, checks_table
+from nmsm.report.status import StageStatus, stage_status
+from nmsm.report.tables import BUILDERS, ReportTable, ReportText, checks_table
 
 REPORT_FILE = "report.html"
 #: pipeline stage kind -> report section kind
 KIND_SECTIONS = {"jmp": "jmp", "analysis": "analysis", "mtp": "mtp", "ncp": "ncp", "gcp": "gcp", "to": "treatment",
                  "vo": "treatment", "do": "treatment"}
-_STYLE = """
-body { font-family: sans-serif; margin: 2em; max-width: 1200px; }
-table { border-collapse: collapse; margin: 0.5em 0 1.5em 0; font-size: 0.9em; }
-th, td { border: 1px solid #bbb; padding: 3px 8px; text-align: right; }
-th { background: #eee; } td:first-child, th:first-child { text-align: left; }
-td.OUT { color: #b00; font-weight: bold; } td.within { color: #070; }
-img { max-width: 100%; border: 1px solid #ddd; margin: 4px 0; }
-.note { color: #555; font-size: 0.85em; }
-"""
 
 
-def _stages(root: Path) -> list[tuple[str, str, Path, str]]:
-    """``(name, section kind, folder, description)`` of the stages in ``root``."""
+@attrs.frozen
+class Figure:
+    """An embedded figure: file name and ``data:`` URI of the PNG."""
+
+    name: str
+    uri: str
+
+
+@attrs.define
+class StageView:
+    """What the templates show of one stage. ``kind`` is the section kind (None: a pipeline
+    stage without results to show, such as preprocessing; it gets a status row only)."""
+
+    name: str
+    kind: str | None
+    folder: Path
+    description: str
+    seconds: float | None = None
+    #: the kind shown in the status table (the pipeline's stage kind, e.g. ``to``)
+    label: str = ""
+    status: StageStatus = attrs.field(factory=StageStatus)
+    tables: list[ReportTable] = attrs.field(factory=list)
+    texts: list[ReportText] = attrs.field(factory=list)
+    figures: list[Figure] = attrs.field(factory=list)
+
+    @property
+    def has_section(self) -> bool:
+        return self.kind is not None
+
+    @property
+    def anchor(self) -> str:
+        return "stage-" + re.sub(r"[^A-Za-z0-9_-]+", "-", self.name).strip("-")
+
+    @property
+    def seconds_text(self) -> str:
+        seconds = self.seconds if self.seconds is not None else self.status.seconds
+        return "" if seconds is None else f"{seconds:.1f}"
+
+
+def _stages(root: Path) -> list[StageView]:
+    """The stages of ``root``, in pipeline order (module docstring)."""
     state = root / "pipeline_state.json"
     if state.is_file():
         data = json.loads(state.read_text(encoding="utf-8"))
         out = []
         for name, record in data.get("stages", {}).items():
-            section = KIND_SECTIONS.get(record.get("kind", ""))
-            if section is None:
-                continue
-            folder = root / record["results_directory"]
-            out.append((name, section, folder,
-                        f"{record['kind']}, finished {record.get('finished', '')}, {record.get('wall_time', 0):.1f} s"))
+            kind = record.get("kind", "")
+            finished = record.get("finished", "")
+            out.append(StageView(name, KIND_SECTIONS.get(kind), root / record["results_directory"],
+                                 f"{kind}, finished {finished}" if finished else kind, record.get("wall_time"), kind))
         return out
     from nmsm.plots.cli import results_folders
 
-    return [(str(folder.relative_to(root)) or folder.name, tool, folder, tool) for tool, folder in results_folders(root)]
-
-
-def _table_html(table: ReportTable) -> str:
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in table.headers)
-    body = []
-    for row in table.rows:
-        cells = "".join(f"<td class=\"{html.escape(c) if c in ('OUT', 'within') else ''}\">{html.escape(c)}</td>"
-                        for c in row)
-        body.append(f"<tr>{cells}</tr>")
-    note = f"<p class=\"note\">{html.escape(table.note)}</p>" if table.note else ""
-    return f"<h3>{html.escape(table.title)}</h3><table><tr>{head}</tr>{''.join(body)}</table>{note}"
+    return [StageView(str(folder.relative_to(root)) if folder != root else folder.resolve().name, tool, folder, tool,
+                      label=tool) for tool, folder in results_folders(root)]
 
 
 def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], None] | None) -> list[Path]:
@@ -92,25 +124,50 @@ def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], Non
         return []
 
 
-def _image(path: Path) -> str:
+def _figure(path: Path) -> Figure:
     data = base64.b64encode(Path(path).read_bytes()).decode()
-    return f"<div><img alt=\"{html.escape(Path(path).name)}\" src=\"data:image/png;base64,{data}\"></div>"
+    return Figure(Path(path).name, f"data:image/png;base64,{data}")
 
 
-def _section(name: str, section: str, folder: Path, description: str, scratch: Path,
-             log: Callable[[str], None] | None) -> list[str]:
-    """The HTML parts of one stage: heading, tables, figures (drawn into ``scratch`` if need be)."""
-    parts = [f"<h2>{html.escape(name)}</h2><p class=\"note\">{html.escape(description)}: "
-             f"{html.escape(str(folder))}</p>"]
-    builder = BUILDERS.get(section)
+def _fill(stage: StageView, scratch: Path, log: Callable[[str], None] | None) -> None:
+    """Read one stage's status, tables, texts and figures (drawn into ``scratch`` if need be)."""
+    if stage.kind is None:
+        return
+    stage.status = stage_status(stage.kind, stage.folder)
+    builder = BUILDERS.get(stage.kind)
     if builder is not None:
         try:
-            tables = builder(folder)
+            parts = builder(stage.folder)
         except (OSError, ValueError, KeyError, StopIteration, InputError) as exc:
-            tables = [ReportTable("tables unavailable", ("reason",), ((f"{type(exc).__name__}: {exc}",),))]
-        parts.extend(_table_html(t) for t in tables)
-    parts.extend(_image(p) for p in _figures(section, folder, scratch, log))
-    return parts
+            parts = [ReportText("tables unavailable", f"{type(exc).__name__}: {exc}")]
+        stage.tables = [p for p in parts if isinstance(p, ReportTable)]
+        stage.texts = [p for p in parts if isinstance(p, ReportText)]
+    stage.figures = [_figure(p) for p in _figures(stage.kind, stage.folder, scratch, log)]
+
+
+def _environment() -> Any:
+    import jinja2
+
+    return jinja2.Environment(loader=jinja2.PackageLoader("nmsm.report", "templates"),
+                              autoescape=jinja2.select_autoescape(("html", "j2")), undefined=jinja2.StrictUndefined,
+                              trim_blocks=True, lstrip_blocks=True)
+
+
+def _checks_view(checks: Sequence) -> dict[str, Any]:
+    verdicts = [c.ok for c in checks]
+    return {"table": checks_table(checks), "within": verdicts.count(True), "out": verdicts.count(False),
+            "reported": verdicts.count(None)}
+
+
+def render_report(root: Path, stages: Sequence[StageView], *, checks: Sequence | None = None,
+                  title: str | None = None) -> str:
+    """The page's HTML for ``stages`` (already filled) of the results tree ``root``."""
+    from nmsm import __version__
+
+    return _environment().get_template("report.html.j2").render(
+        title=title or f"nmsm report: {'/'.join(root.resolve().parts[-2:])}", root=str(root.resolve()),
+        written=datetime.datetime.now().isoformat(timespec="seconds"), version=__version__,
+        stages=list(stages), checks=_checks_view(checks) if checks else None)
 
 
 def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str] | None = None, *,
@@ -123,19 +180,13 @@ def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str]
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
     stages = _stages(root)
-    if not stages and not checks:
+    if not any(s.has_section for s in stages) and not checks:
         raise InputError("no results of JMP, MTP, NCP, GCP or treatment optimization found", file=root,
                          expected="a pipeline results tree or a tool's results folder")
-    parts = [f"<h1>{html.escape(title or f'nmsm report: {root.resolve().name}')}</h1>",
-             f"<p class=\"note\">{html.escape(str(root.resolve()))}, "
-             f"{datetime.datetime.now().isoformat(timespec='seconds')}</p>"]
-    if checks:
-        parts.append("<h2>Known-answer comparison</h2>" + _table_html(checks_table(checks)))
     with tempfile.TemporaryDirectory(prefix="nmsm-report-") as drawn:
-        for k, (name, section, folder, description) in enumerate(stages):
-            parts.extend(_section(name, section, folder, description, Path(drawn) / str(k), log))
-    page = (f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{html.escape(title or 'nmsm report')}</title>"
-            f"<style>{_STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+        for k, stage in enumerate(stages):
+            _fill(stage, Path(drawn) / str(k), log)
+        page = render_report(root, stages, checks=checks, title=title)
     target = Path(output) if output is not None else root / REPORT_FILE
     write_output(target, page)
     return target

@@ -29,6 +29,14 @@ class ReportTable:
     note: str = ""
 
 
+@attrs.frozen
+class ReportText:
+    """Free text of a results folder (a tool's summary), shown preformatted."""
+
+    title: str
+    text: str
+
+
 def _f(value: float | None, digits: int = 4) -> str:
     return "" if value is None or not np.isfinite(value) else f"{value:.{digits}g}"
 
@@ -50,11 +58,10 @@ def jmp_tables(folder: Path) -> list[ReportTable]:
     return out
 
 
-def mtp_tables(folder: Path) -> list[ReportTable]:
+def mtp_tables(folder: Path) -> list[ReportTable | ReportText]:
     from nmsm.io.osimx import read_osimx
-    from nmsm.io.storage import read_storage, strip_load_suffix
 
-    out = []
+    out: list[ReportTable | ReportText] = []
     osimx_files = sorted(folder.glob("*.osimx"))
     if osimx_files:
         muscles = read_osimx(osimx_files[0]).muscles
@@ -67,6 +74,22 @@ def mtp_tables(folder: Path) -> list[ReportTable]:
         out.append(ReportTable("MTP muscle parameters",
                                ("muscle", "EMD (ms)", "act. time constant (ms)", "nonlinearity", "EMG scale",
                                 "optimal fiber length (cm)", "tendon slack length (cm)"), rows))
+    rows = tuple((trial, name, _f(rms, 3), _f(peak, 3), _f(reference, 3))
+                 for trial, name, rms, peak, reference in mtp_moment_errors(folder))
+    if rows:
+        out.append(ReportTable("MTP joint moments: model vs inverse dynamics (N m)",
+                               ("trial", "coordinate", "RMS error", "max error", "RMS of ID"), rows))
+    summary = folder / "mtpSummary.txt"
+    if summary.is_file():
+        out.append(ReportText("MTP solver summary", summary.read_text(encoding="utf-8")))
+    return out
+
+
+def mtp_moment_errors(folder: Path) -> list[tuple[str, str, float, float, float]]:
+    """``(trial, coordinate, RMS error, max |error|, RMS of ID)`` (N·m) of MTP's modeled joint
+    moments against inverse dynamics, per trial and coordinate."""
+    from nmsm.io.storage import read_storage, strip_load_suffix
+
     model_files = sorted((folder / "modelMoments").glob("*_modelMoments.sto"))
     measured_files = sorted((folder / "Analysis" / "inverseDynamicsJointMoments").glob("*.sto"))
     rows = []
@@ -78,19 +101,16 @@ def mtp_tables(folder: Path) -> list[ReportTable]:
             if column is None:
                 continue
             error = model.column(column) - measured.column(label)
-            rows.append((model_file.stem.replace("_modelMoments", ""), name, _f(np.sqrt(np.mean(error**2)), 3),
-                         _f(np.abs(error).max(), 3), _f(np.sqrt(np.mean(measured.column(label) ** 2)), 3)))
-    if rows:
-        out.append(ReportTable("MTP joint moments: model vs inverse dynamics (N m)",
-                               ("trial", "coordinate", "RMS error", "max error", "RMS of ID"), tuple(rows)))
-    return out
+            rows.append((model_file.stem.replace("_modelMoments", ""), name, float(np.sqrt(np.mean(error**2))),
+                         float(np.abs(error).max()), float(np.sqrt(np.mean(measured.column(label) ** 2)))))
+    return rows
 
 
-def ncp_tables(folder: Path) -> list[ReportTable]:
+def ncp_tables(folder: Path) -> list[ReportTable | ReportText]:
     log = folder / "commandWindowOutput.txt"
-    lines = log.read_text(encoding="utf-8").splitlines()[:12] if log.is_file() else []
-    rows = tuple(("", line.strip()) for line in lines)
-    out = [ReportTable("NCP run", ("", "summary"), rows)] if rows else []
+    out: list[ReportTable | ReportText] = []
+    if log.is_file():
+        out.append(ReportText("NCP run", log.read_text(encoding="utf-8")))
     info = folder / "ncpRunInfo.json"
     if info.is_file():
         data = json.loads(info.read_text(encoding="utf-8"))
@@ -99,7 +119,7 @@ def ncp_tables(folder: Path) -> list[ReportTable]:
     return out
 
 
-def gcp_tables(folder: Path) -> list[ReportTable]:
+def gcp_tables(folder: Path) -> list[ReportTable | ReportText]:
     from nmsm.io.osimx import read_osimx
 
     out = []
@@ -116,43 +136,78 @@ def gcp_tables(folder: Path) -> list[ReportTable]:
                                ("surface", "hindfoot", "springs", "spring constant N/m mean (range)",
                                 "resting length (mm)", "damping (s/m)", "dynamic friction", "viscous friction (s/m)"),
                                tuple(rows)))
-    for errors in sorted(folder.glob("*_gcpErrors.txt")):
-        lines = [line.split() for line in errors.read_text(encoding="utf-8").splitlines()[2:] if line.strip()]
-        rows = tuple((" ".join(p[:-1]), p[-1]) for p in lines if len(p) >= 2)
-        out.append(ReportTable("GCP RMS errors (modeled vs experimental)", ("quantity", "foot 1"), rows))
+    errors = gcp_errors(folder)
+    if errors:
+        feet = list(errors)
+        labels = list(dict.fromkeys(label for values in errors.values() for label in values))
+        out.append(ReportTable("GCP RMS errors (modeled vs experimental)", ("quantity", *feet),
+                               tuple((label, *(_f(errors[f].get(label)) for f in feet)) for label in labels)))
+    log = folder / "commandWindowOutput.txt"
+    if log.is_file():
+        out.append(ReportText("GCP run", log.read_text(encoding="utf-8")))
     return out
 
 
-def treatment_tables(folder: Path) -> list[ReportTable]:
+def gcp_errors(folder: Path) -> dict[str, dict[str, float]]:
+    """GCP's RMS errors (``<model>_gcpErrors.txt``, :func:`nmsm.tools.gcp.report.format_error_table`:
+    a title, a header of 14-character column names after a 22-character label column, one
+    row per quantity): column (foot) -> quantity label -> value (N, N m, mm, deg as the
+    labels say). With several files the columns are prefixed by the file's model name."""
+    files = sorted(folder.glob("*_gcpErrors.txt"))
+    out: dict[str, dict[str, float]] = {}
+    for path in files:
+        lines = [line for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+        if len(lines) < 3:
+            continue
+        names = [lines[1][22 + 14 * k:22 + 14 * (k + 1)].strip() for k in range((len(lines[1]) - 22 + 13) // 14)]
+        names = [n for n in names if n and n != "ratio"]
+        prefix = f"{path.stem.removesuffix('_gcpErrors')}: " if len(files) > 1 else ""
+        for line in lines[2:]:
+            label, values = line[:22].strip(), line[22:].split()
+            for name, value in zip(names, values):
+                out.setdefault(prefix + name, {})[label] = float(value)
+    return out
+
+
+def treatment_tables(folder: Path) -> list[ReportTable | ReportText]:
+    out: list[ReportTable | ReportText] = []
+    rows = tuple((label, _f(rms, 3), _f(peak, 3)) for label, rms, peak, _ in treatment_tracking_errors(folder))
+    if rows:
+        out.append(ReportTable("Tracking: modeled vs tracked coordinates (deg for rotations, m for translations)",
+                               ("coordinate", "RMS", "max"), rows))
+    for convergence in sorted(folder.glob("*_convergence.txt")) or sorted(folder.glob("*/*_convergence.txt")):
+        out.append(ReportText(str(convergence.relative_to(folder)), convergence.read_text(encoding="utf-8")))
+    return out
+
+
+def treatment_tracking_errors(folder: Path) -> list[tuple[str, float, float, bool]]:
+    """``(coordinate, RMS, max |error|, rotational)`` of the modeled vs tracked state
+    coordinates (``Analysis/*_modeledPositions.sto``); degrees for rotations (labels the
+    model-free files cannot tell apart: a coordinate ending in ``_tx``, ``_ty``, ``_tz`` is
+    translational, m)."""
     from nmsm.io.storage import read_storage
 
-    out = []
-    for convergence in sorted(folder.glob("*_convergence.txt")):
-        lines = convergence.read_text(encoding="utf-8").splitlines()[:14]
-        out.append(ReportTable(f"{convergence.stem}", ("",), tuple((line,) for line in lines)))
+    rows = []
     modeled = sorted((folder / "Analysis").glob("*_modeledPositions.sto"))
     tracked = sorted((folder / "Analysis").glob("*_trackedPositions.sto"))
     for m_file, t_file in zip(modeled, tracked):
         m, t = read_storage(m_file), read_storage(t_file)
-        rows = []
         for label in m.labels:
             if not t.has(label):
                 continue
+            rotational = not label.endswith(("_tx", "_ty", "_tz"))
             error = m.column(label) - t.column(label)
-            error = error if m.in_degrees else np.degrees(error)
-            rows.append((label, _f(np.sqrt(np.mean(error**2)), 3), _f(np.abs(error).max(), 3)))
-        if rows:
-            out.append(ReportTable("Tracking: modeled vs tracked coordinates (deg for rotations)",
-                                   ("coordinate", "RMS", "max"), tuple(rows)))
-    return out
+            if rotational and not m.in_degrees:
+                error = np.degrees(error)
+            rows.append((label, float(np.sqrt(np.mean(error**2))), float(np.abs(error).max()), rotational))
+    return rows
 
 
-def analysis_tables(folder: Path) -> list[ReportTable]:
+def analysis_tables(folder: Path) -> list[ReportTable | ReportText]:
     report = folder / "analysis_report.txt"
     if not report.is_file():
         return []
-    lines = report.read_text(encoding="utf-8").splitlines()
-    return [ReportTable("IK, ID and muscle analysis", ("",), tuple((line,) for line in lines))]
+    return [ReportText("IK, ID and muscle analysis", report.read_text(encoding="utf-8"))]
 
 
 def checks_table(checks: Sequence) -> ReportTable:

@@ -185,3 +185,46 @@ def test_mtp_and_ncp_stages_converge(early, tmp_path) -> None:
     assert found is not None, log
     assert found.group(1) in ("Solve_Succeeded", "Solved_To_Acceptable_Level")
     assert int(found.group(2)) < 1000
+
+
+#: what the browser test reads of the page, as JSON: title, the status table's and the first
+#: figure's top edges (CSS px from the top of the first screen), whether every image decoded
+PAGE_FACTS = """(() => {
+  const box = (el) => el ? el.getBoundingClientRect().top : null;
+  const images = Array.from(document.images);
+  const status = document.querySelector('table.status');
+  const figure = document.querySelector('.figures img');
+  return {title: document.title, h1: document.querySelector('h1').textContent, screen: window.innerHeight,
+          status_top: box(status), status_rows: status ? status.rows.length - 1 : 0,
+          status_links: Array.from(document.querySelectorAll('table.status a')).map(a => a.getAttribute('href')),
+          figure_top: box(figure), figure_width: figure ? figure.getBoundingClientRect().width : 0,
+          images: images.length, decoded: images.filter(i => i.complete && i.naturalWidth > 0).length,
+          pre: document.querySelectorAll('details pre').length,
+          anchors: Array.from(document.querySelectorAll('section[id]')).map(s => s.id)};
+})()"""
+
+
+def test_report_in_a_browser(early, tmp_path: Path, chromium: str) -> None:
+    """The example's report in headless Chromium (1280 x 900): no error while loading; the
+    status table (every stage, linked to its section) and a decoded figure in the first screen."""
+    from browser_page import load_page
+
+    from nmsm.report.html import write_report
+
+    page = write_report(early.results, tmp_path / "report.html", checks=early.checks, log=None,
+                        title="nmsm example: synthetic subject")
+    loaded = load_page(chromium, page, PAGE_FACTS)
+    (tmp_path / "first_screen.png").write_bytes(loaded.screenshot)
+    facts = loaded.value
+    assert loaded.errors == [], loaded.errors
+    assert facts["title"] == facts["h1"] == "nmsm example: synthetic subject"
+    stages = list(json.loads((early.results / "pipeline_state.json").read_text())["stages"])
+    assert facts["status_rows"] == len(stages)
+    assert 0 <= facts["status_top"] < facts["screen"]
+    for link in facts["status_links"]:
+        assert link[1:] in facts["anchors"], link
+    assert "#stage-jmp" in facts["status_links"]
+    assert facts["figure_top"] is not None and 0 < facts["figure_top"] < facts["screen"] - 100, facts
+    assert facts["figure_width"] >= 400 and facts["images"] >= 2 and facts["decoded"] == facts["images"]
+    assert facts["pre"] >= 1  # summaries are preformatted text
+    assert loaded.screenshot[:8] == b"\x89PNG\r\n\x1a\n"
