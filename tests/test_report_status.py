@@ -24,11 +24,14 @@ def test_converged_statuses(status: str, converged: bool) -> None:
 def test_solver_outcomes_of_every_summary_shape() -> None:
     text = ("task 1 (3.0 s): ipopt: Solve_Succeeded after 12 iterations, 2.50 s, cost 1.5\n"
             "task 2: Maximum_Iterations_Exceeded; cost 0.5; 300 iterations; 4.25 s\n"
-            "walk: IPOPT Solved_To_Acceptable_Level after 7 iterations, 1.00 s; objective 3\n")
+            "walk: IPOPT Solved_To_Acceptable_Level after 7 iterations, 1.00 s; objective 3\n"
+            "task 3 (9.0 s): least_squares (lifted foot coordinates): The maximum number of function evaluations is "
+            "exceeded. after 60 iterations, 8.50 s, cost 0.6\n")
     found = solver_outcomes(text)
     assert [(o.status, o.iterations, o.seconds, o.converged) for o in found] == [
         ("Solve_Succeeded", 12, 2.5, True), ("Maximum_Iterations_Exceeded", 300, 4.25, False),
-        ("Solved_To_Acceptable_Level", 7, 1.0, True)]
+        ("Solved_To_Acceptable_Level", 7, 1.0, True),
+        ("The maximum number of function evaluations is exceeded.", 60, 8.5, False)]
 
 
 def _treatment_folder(folder: Path, status: str, violated: int = 0) -> None:

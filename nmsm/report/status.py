@@ -25,8 +25,8 @@ import numpy as np
 #: solver statuses that mean a converged solve
 CONVERGED_STATUSES = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level", "nothing to optimize"})
 
-#: ``Solution.summary()``'s first line: ``<backend>: <status> after <n> iterations, <t> s, cost ...``
-_SUMMARY = re.compile(r"\b(?:ipopt|least_squares): (.+?) after (\d+) iterations, ([\d.]+) s")
+#: ``Solution.summary()``'s first line: ``<backend>[ (<detail>)]: <status> after <n> iterations, <t> s, cost ...``
+_SUMMARY = re.compile(r"\b(?:ipopt|least_squares)(?: \([^)]*\))?: (.+?) after (\d+) iterations, ([\d.]+) s")
 #: a treatment convergence file's first line: ``<problem>: IPOPT <status> after <n> iterations, <t> s``
 _TREATMENT = re.compile(r"IPOPT (\S+) after (\d+) iterations, ([\d.]+) s")
 #: MTP's ``mtpSummary.txt``: ``task <k>: <status>; cost <c>; <n> iterations; <t> s``
