@@ -17,6 +17,7 @@ from typing import Any
 
 from nmsm import __version__
 from nmsm.cli_types import non_negative_float
+from nmsm.core.console import console_output
 from nmsm.core.progress import DEFAULT_INTERVAL, progress_every
 from nmsm.errors import NmsmError
 
@@ -134,7 +135,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     warnings.simplefilter("default")
     warnings.formatwarning = lambda msg, cat, *a, **k: f"warning: {msg}\n"
     try:
-        with progress_every(args.progress), each_warning_once():
+        with progress_every(args.progress), console_output(), each_warning_once():
             return int(args.func(args) or 0)
     except NmsmError as exc:
         if args.traceback:

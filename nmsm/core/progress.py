@@ -69,6 +69,18 @@ class SolveProgress:
         print(f"[progress] {self.name}: {', '.join(parts)}", file=self.stream, flush=True)
 
 
+    def due(self) -> bool:
+        """True when a line is due (``interval`` s since the last one), without counting an iteration."""
+        return time.perf_counter() - self._last >= self.interval
+
+    def report_items(self, done: int, total: int, unit: str) -> None:
+        """Print ``[progress] <name>: <done> of <total> <unit>, <t> s`` (work counted in items)."""
+        now = time.perf_counter()
+        self._last = now
+        print(f"[progress] {self.name}: {done} of {total} {unit}, {now - self._start:.0f} s", file=self.stream,
+              flush=True)
+
+
 def solve_progress(name: str) -> SolveProgress | None:
     """A reporter for a solve named ``name``, or None when progress lines are off."""
     interval = _INTERVAL.get()

@@ -41,6 +41,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import build_terms
@@ -203,6 +204,10 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
     all_feet, casadi_model, motion, grf, osimx = load_feet(
         settings, spring_locations=Path(spring_locations) if spring_locations is not None else None)
     groups_inputs = [all_feet] if feet == "together" else [[f] for f in all_feet]
+    announce("GCP", settings=path, model=settings.input_model_file, trials=[Path(settings.input_motion_file).name],
+             problem=f"{len(all_feet)} foot/feet ({', '.join(f.surface.hindfoot_body for f in all_feet)}), "
+                     f"{sum(f.springs.n_springs for f in all_feet)} springs, {all_feet[0].n_frames} frames, "
+                     f"{len(settings.tasks)} task(s), feet {feet}")
     groups: list[GroupResult] = []
     latest: list[GroupResult] = []  # the group in progress, after its last finished task
 
@@ -227,7 +232,28 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
         raise
     errors = _write(results, settings, groups, casadi_model, motion, grf, osimx, update_motion)
     results.copy_in(path)
-    return GcpRunResult(settings, groups, results.path, errors, time.perf_counter() - start)
+    outcome = GcpRunResult(settings, groups, results.path, errors, time.perf_counter() - start)
+    summarize("GCP", summary_lines(outcome))
+    return outcome
+
+
+def summary_lines(outcome: GcpRunResult) -> list[str]:
+    """The console summary: each task's solver outcome, the force and moment RMS errors per
+    foot (N, N·m) and the kinematic errors, the time."""
+    lines = []
+    for g, group in enumerate(outcome.groups, start=1):
+        feet = ", ".join(f"foot {f.index}" for f in group.feet)
+        for k, solution in enumerate(group.solutions, start=1):
+            lines.append(f"{feet}, task {k}: {solution.status} after {solution.iterations} iterations, "
+                         f"{solution.wall_time:.1f} s")
+    for foot, errors in outcome.errors.items():
+        forces = ", ".join(f"{label.split()[0]} {errors[label]:.3g}" for label in report.ROWS[:3])
+        moments = ", ".join(f"{label.split()[0]} {errors[label]:.3g}" for label in report.ROWS[3:6])
+        lines.append(f"foot {foot}: force RMS (N) {forces}; moment RMS (N·m) {moments}; translation "
+                     f"{errors[report.ROWS[6]]:.3g} mm, rotation {errors[report.ROWS[7]]:.3g} deg, markers "
+                     f"{errors[report.ROWS[8]]:.3g} mm")
+    lines.append(f"total time {outcome.wall_time:.1f} s")
+    return lines
 
 
 def _write(results: ResultsDirectory, settings: GroundContactPersonalizationSettings, groups: list[GroupResult],

@@ -38,6 +38,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.results import ResultsDirectory
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
@@ -143,13 +144,17 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
 
     def log(text: str) -> None:
         log_lines.append(text)
-        if not quiet:
-            print(text, flush=True)
+        if not quiet and console_enabled():
+            print(f"  {text}", flush=True)
 
     tolerances = tolerances_from_settings(settings, max_iterations=max_iterations)
-    log(f"Joint Model Personalization: {settings.settings_file}")
-    log(f"model {settings.input_model_file}; {len(settings.tasks)} task(s); allowable error "
-        f"{settings.allowable_error:g} m")
+    if not quiet:
+        announce("JMP", settings=settings.settings_file, model=settings.input_model_file,
+                 trials=[Path(t.marker_file_name).name for t in settings.tasks],
+                 problem=f"{len(settings.tasks)} task(s), allowable marker error {settings.allowable_error:g} m")
+    log_lines.append(f"Joint Model Personalization: {settings.settings_file}")
+    log_lines.append(f"model {settings.input_model_file}; {len(settings.tasks)} task(s); allowable error "
+                     f"{settings.allowable_error:g} m")
     log(f"solver: exact-Jacobian Levenberg-Marquardt, function tolerance {tolerances.ftol:g}, step tolerance "
         f"{tolerances.xtol:g}, optimality tolerance {tolerances.gtol:g}, max evaluations {tolerances.max_evaluations}"
         f"; IK accuracy {settings.accuracy if settings.accuracy is not None else 'default (1e-5)'}"
@@ -179,7 +184,9 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
               f"input model: {settings.input_model_file}\noutput model: {results.path / final_name}\n"
               f"allowable error: {settings.allowable_error:g} m; total time {wall:.1f} s\n")
     report = header + "\n" + "\n".join(blocks)
-    log(report)
+    log_lines.append(report)
+    if not quiet:
+        summarize("JMP", summary_lines(task_results, wall))
     results.write_text(REPORT_FILE, report)
     write_summary(results, settings, summaries, wall)
     settings_copy = results.path / Path(settings.settings_file).name
@@ -192,6 +199,22 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
         plot_jmp_results(results.path)
     return JmpRun(settings=settings, tasks=tuple(task_results), output_model=results.path / final_name,
                   results_directory=results.path, report=report, wall_time=wall)
+
+
+def summary_lines(tasks: Sequence[TaskResult], wall_time: float) -> list[str]:
+    """The console summary: per task the solver's outcome, the marker RMS before and after
+    (mm) and the parameters that ended at a bound; the total time."""
+    lines = []
+    for result in tasks:
+        solution = result.solution
+        lines.append(f"{result.label}: {solution.status} after {solution.iterations} iterations; marker RMS "
+                     f"{1000 * result.before.marker_rms():.2f} -> {1000 * result.after.marker_rms():.2f} mm")
+        at_bound = [v.label for v, value in zip(result.design.variables, solution.p)
+                    if min(abs(value - v.lower), abs(value - v.upper)) <= 1e-9]
+        lines.append(f"  parameters at a bound: {', '.join(at_bound) if at_bound else 'none'} "
+                     f"(of {len(result.design.variables)})")
+    lines.append(f"total time {wall_time:.1f} s; report: {REPORT_FILE}")
+    return lines
 
 
 def write_summary(results: ResultsDirectory, settings: JointModelPersonalizationSettings,

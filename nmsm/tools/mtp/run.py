@@ -34,6 +34,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.console import announce, summarize
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import CostTerm, build_terms
 from nmsm.errors import InputError, SolverError
@@ -57,6 +58,7 @@ from nmsm.tools.mtp.problem import (
     solve_task_problem,
     updated_state,
 )
+from nmsm.tools.mtp.summary import summary_lines
 from nmsm.tools.mtp.synx import build_synergy_extrapolation
 
 #: settings flag -> design block
@@ -330,6 +332,11 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
                                settings_file=settings_file)
     _log(verbose, f"{len(setup.data.trials)} trials, {setup.data.muscles.n_muscles} muscles, "
                   f"{len(setup.data.coordinates)} coordinates, SynX {'on' if setup.data.synx else 'off'}")
+    announce("MTP", settings=settings_file, model=settings.input_model_file,
+             trials=[t.name for t in setup.data.trials],
+             problem=f"{setup.data.muscles.n_muscles} muscles, {len(setup.data.coordinates)} coordinates, "
+                     f"{sum(t.time.size for t in setup.data.trials)} frames, {len(setup.tasks)} task(s), "
+                     f"SynX {'on' if setup.data.synx else 'off'}")
     start_data, mtli = initialize_lengths(setup)
     if mtli is not None:
         _log(verbose, f"MTLI: {mtli.solution.status}, cost {mtli.solution.cost:.6g}")
@@ -347,6 +354,7 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
                          time.perf_counter() - start)
     write_results(outcome, results)
     results.copy_in(settings_file, Path(settings_file).name)
+    summarize("MTP", summary_lines(outcome))
     return outcome
 
 

@@ -25,6 +25,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError, SolverError
@@ -147,6 +148,21 @@ def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metric
     return "\n".join(lines) + "\n"
 
 
+def summary_lines(solved: Solution, metrics: FitMetrics, wall: float) -> list[str]:
+    """The console summary: IPOPT's outcome, the moment RMS per coordinate (N·m), the
+    activation RMS and VAF against MTP's activations, the time."""
+    lines = [f"IPOPT {solved.status} after {solved.iterations} iterations, {solved.wall_time:.1f} s; cost "
+             f"{solved.cost:.6g}", "joint moment RMS error (N·m):"]
+    lines += [f"  {c:<32s} {v:8.3f}" for c, v in zip(metrics.coordinates, metrics.moment_rms)]
+    if metrics.mtp_muscles:
+        lines.append(f"activation RMS vs MTP {metrics.activation_rms_pooled:.4f} ({len(metrics.mtp_muscles)} muscles, "
+                     f"pooled); VAF {100 * metrics.activation_vaf:.2f} %")
+    else:
+        lines.append("activation RMS vs MTP: none (no muscle has MTP activations)")
+    lines.append(f"total time {wall:.1f} s")
+    return lines
+
+
 def _check_writable(folder: Path, settings_file: Path) -> None:
     """Fail before optimizing when the results folder cannot (or must not) be written.
 
@@ -203,6 +219,11 @@ def run_settings(
                                input_folders=trial_table_folders(settings.data_directory, "<data_directory>"),
                                input_roots=roots, record="ncp", settings_file=settings.settings_file)
     options = _ipopt_options(settings, {"max_iter": max_iterations, "tol": tolerance, "print_level": print_level, **ipopt})
+    layout = setup.inputs.layout
+    announce("NCP", settings=settings.settings_file, model=settings.input_model_file,
+             trials=[t.name for t in setup.inputs.trials],
+             problem=f"{layout.n_muscles} muscles, {layout.n_synergies} synergies in {len(layout.groups)} group(s), "
+                     f"{len(setup.inputs.mtp_muscles)} muscles with MTP activations")
     raw, solved = solve(setup, proximal_weight=proximal_weight, **options)
     solution = raw.normalized()
     costs = score(setup.inputs, setup.terms, solution)
@@ -230,6 +251,7 @@ def run_settings(
         from nmsm.plots.ncp import plot_ncp_results
 
         plot_ncp_results(out_dir, out_dir / "plots")
+    summarize("NCP", summary_lines(solved, metrics, wall))
     return NcpRun(
         setup=setup,
         solution=solution,

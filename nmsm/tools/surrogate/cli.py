@@ -116,6 +116,11 @@ def _fit(args: argparse.Namespace, staged: StagedOutputs) -> tuple[Any, Path, bo
     coords, poses = poses_around_motion(args.model, motion, angular_padding=math.radians(args.angular_padding),
                                         linear_padding=args.linear_padding, samples_per_frame=args.samples_per_frame,
                                         seed=args.seed, varied=None if args.vary_all else args.coordinates)
+    from nmsm.core.console import announce
+
+    announce("surrogate", settings=None, model=args.model, trials=[Path(args.motion).name],
+             problem=f"{poses.shape[0]} poses ({args.samples_per_frame} per frame) varying {len(coords)} coordinates, "
+                     f"moment arms of {len(args.coordinates)} coordinates, degree {args.degree}")
     samples = opensim_samples(args.model, coords, poses, args.coordinates, muscles=args.muscles,
                               moment_arms=args.moment_arms)
     if args.write_samples:

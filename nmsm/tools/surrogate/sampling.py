@@ -23,12 +23,17 @@ from typing import Any
 
 import numpy as np
 
+from nmsm.core.progress import solve_progress
 from nmsm.errors import InputError
 from nmsm.io.storage import Table
 from nmsm.model.surrogate import GeometrySamples
 from nmsm.model.surrogate_sampling import coordinate_padding, latin_hypercube_poses
 
 MOMENT_ARM_KINDS = ("derivative", "opensim")
+#: with progress lines on, poses go to OpenSim in calls of at least this many poses ...
+POSES_PER_CALL = 100
+#: ... and at most this many calls, so a line can be printed between them
+MAX_CALLS = 50
 
 
 def _bridge(bridge: Any) -> Any:
@@ -123,14 +128,23 @@ def opensim_samples(
         muscles = info["muscles"]
     check_model_names("muscles", muscles, info["muscles"], str(model_file))
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
-    kw = dict(model=path, q=poses, coordinates=list(pose_coordinates), muscles=list(muscles))
-    if moment_arms == "derivative":
-        out = bridge.call("muscle_length_gradients", wrt=list(surrogate_coordinates), **kw)
-        lengths, arms = out["lengths"], -out["gradient"]
-    else:
-        lengths = bridge.call("muscle_lengths", **kw)
-        arms = bridge.call("muscle_moment_arms", moment_arm_coordinates=list(surrogate_coordinates), **kw)
-    full = bridge.call("coupled_poses", model=path, q=poses, coordinates=list(pose_coordinates))
+    progress = solve_progress("surrogate sampling")
+    chunk = poses.shape[0] if progress is None else max(POSES_PER_CALL, -(-poses.shape[0] // MAX_CALLS))
+    parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    for start in range(0, poses.shape[0], chunk):
+        block = poses[start:start + chunk]
+        kw = dict(model=path, q=block, coordinates=list(pose_coordinates), muscles=list(muscles))
+        if moment_arms == "derivative":
+            out = bridge.call("muscle_length_gradients", wrt=list(surrogate_coordinates), **kw)
+            lengths, arms = out["lengths"], -out["gradient"]
+        else:
+            lengths = bridge.call("muscle_lengths", **kw)
+            arms = bridge.call("muscle_moment_arms", moment_arm_coordinates=list(surrogate_coordinates), **kw)
+        parts.append((np.asarray(lengths), np.asarray(arms),
+                      bridge.call("coupled_poses", model=path, q=block, coordinates=list(pose_coordinates))))
+        if progress is not None and progress.due():
+            progress.report_items(start + block.shape[0], poses.shape[0], "poses")
+    lengths, arms, full = (np.concatenate([p[k] for p in parts]) for k in range(3))
     names = info["coordinates"]
     q = full[:, [names.index(c) for c in surrogate_coordinates]]
     return GeometrySamples(tuple(surrogate_coordinates), tuple(muscles), q, lengths, arms)

@@ -33,6 +33,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import SUPERSEDED, ResultsDirectory
 from nmsm.errors import InputError, SolverError
@@ -218,6 +219,10 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
     x0 = np.clip(x0, lo, hi)
     initial_cost = float(np.asarray(problem.evaluate(problem.objective(), x0)).ravel()[0])
     trial = settings.trial_name
+    constraint_rows = sum(int(np.size(c.lower)) for c in problem.constraints)
+    announce(prepared.tool, settings=path, model=settings.input_model_file, trials=[trial],
+             problem=f"{prepared.plan.mesh.n_intervals} mesh intervals, {problem.n_variables} variables, "
+                     f"{constraint_rows} constraint rows, {len(problem.costs)} cost terms")
     if opts.evaluate_only:
         solution = Solution(problem.unpack(x0), initial_cost, problem.term_costs(x0), False, "not solved (evaluate_only)",
                             0, 0.0, "none", x0, problem.constraint_report(x0))
@@ -232,7 +237,12 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
     # the IPOPT log is written into a hidden folder of this run, removed however the run ends
     log_dir = Path(tempfile.mkdtemp(prefix=".ipopt-", dir=results.ensure())) if results is not None else None
     try:
-        return _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
+        run = _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
+        if console_enabled():
+            from nmsm.tools.treatment.summary import summary_lines
+
+            summarize(prepared.tool, summary_lines(run, problem.term_costs(x0)))
+        return run
     finally:
         if log_dir is not None:
             shutil.rmtree(log_dir, ignore_errors=True)

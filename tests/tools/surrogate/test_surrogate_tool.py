@@ -192,3 +192,26 @@ def test_motions_whose_degrees_header_looks_wrong_warn(shared_data, bridge, tmp_
                         " the numbers look like degrees: the header may be wrong (inDegrees=yes)")
     with pytest.warns(UserWarning, match=expected):
         assert nmsm_main(["surrogate", *common, "--data-dir", str(folder), "-o", str(tmp_path / "from_data.json")]) == 0
+
+
+def test_sampling_reports_progress_and_gives_the_same_samples(shared_data, bridge, capsys) -> None:
+    """With progress lines on, the poses go to OpenSim in calls of 100 and a line follows each
+    call that ends after the interval; the samples are those of one call."""
+    from nmsm.core.progress import progress_every
+
+    model_file = shared_data / KICK / "RightLegAndPelvis.osim"
+    motion = read_storage(shared_data / KICK / "preprocessed/IKData/drive_kick1.sto")
+    reference = attrs.evolve(motion, time=motion.time[::10], data=motion.data[::10])
+    coords, poses = poses_around_motion(model_file, reference, samples_per_frame=50, seed=0, varied=COORDINATES,
+                                        bridge=bridge)
+    assert poses.shape[0] == 300
+    whole = opensim_samples(model_file, coords, poses, COORDINATES, muscles=["soleus_r", "gasmed_r"], bridge=bridge)
+    capsys.readouterr()
+    with progress_every(1e-9):
+        chunked = opensim_samples(model_file, coords, poses, COORDINATES, muscles=["soleus_r", "gasmed_r"],
+                                  bridge=bridge)
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[progress]")]
+    assert [re.sub(r", \d+ s$", "", line) for line in lines] == [
+        f"[progress] surrogate sampling: {n} of 300 poses" for n in (100, 200, 300)]
+    for name in ("q", "lengths", "moment_arms"):
+        np.testing.assert_allclose(getattr(chunked, name), getattr(whole, name), rtol=0, atol=1e-12)
