@@ -1,6 +1,6 @@
 """Progress lines for long solves.
 
-The command line switches them on (:func:`progress_every`, every 10 s by default; ``nmsm
+The command line switches them on (:func:`progress_every`, every 5 s by default; ``nmsm
 --progress 0`` turns them off); library calls stay silent unless they do the same. A back end
 asks :func:`solve_progress` for a reporter and calls :meth:`SolveProgress.tick` once per
 iteration; a line is due only when ``interval`` seconds have passed since the last one (or
@@ -24,7 +24,7 @@ import numpy as np
 _INTERVAL: contextvars.ContextVar[float | None] = contextvars.ContextVar("nmsm_progress_interval", default=None)
 
 #: seconds between progress lines of the command line
-DEFAULT_INTERVAL = 10.0
+DEFAULT_INTERVAL = 5.0
 
 
 @contextlib.contextmanager

@@ -1,14 +1,15 @@
 """``nmsm plot RESULTS_DIR``: the figures of every results folder found in a tree.
 
-The folder itself and every folder below it (``plots`` and hidden folders skipped) is
-tested against each tool's results layout; each match is drawn by the tool's plot module
+The folder itself and every folder below it (``plots`` and hidden folders skipped) is tested
+against each tool's results layout; each match is drawn by the tool's plot module
 (:mod:`nmsm.plots.jmp`, ``mtp``, ``ncp``, ``gcp``, ``treatment``) into ``<folder>/plots``, or
-into ``--output/<folder relative to RESULTS_DIR>``. A pipeline results tree (``nmsm
-pipeline``) gets every stage's figures this way. Each folder's figures are drawn into a
-hidden staging folder and moved into place together when all are drawn
-(:func:`nmsm.io.output_file.staged_outputs`): a folder whose figures fail gets none of them
-(its earlier figures stay, folders created for it are removed), is reported, and the others
-are still drawn (exit code 1); Ctrl-C keeps the folders finished before it.
+into ``--output/<folder relative to RESULTS_DIR>``. ``nmsm plot --compare A B C`` draws the
+treatment figures of A with B and C overlaid (``compare_<trial>_*.png`` in ``A/plots`` or
+``-o``). A pipeline results tree (``nmsm pipeline``) gets every stage's figures this way. Each
+folder's figures are drawn into a hidden staging folder and moved into place together when all
+are drawn (:func:`nmsm.io.output_file.staged_outputs`): a folder whose figures fail gets none
+of them (its earlier figures stay, folders created for it are removed), is reported, and the
+others are still drawn (exit code 1); Ctrl-C keeps the folders finished before it.
 """
 
 from __future__ import annotations
@@ -101,12 +102,42 @@ def plot_tree(root: str | os.PathLike[str], output: str | os.PathLike[str] | Non
     return figures, errors
 
 
+def _compare(args: argparse.Namespace) -> int:
+    """``nmsm plot --compare A B C``: A's treatment figures with B and C overlaid, named
+    ``compare_<trial>_*.png``, into ``-o`` (default ``A/plots``), all or none."""
+    from nmsm.errors import InputError
+    from nmsm.io.output_file import check_default_folder_writable, check_output_folder, staged_outputs
+    from nmsm.plots.treatment import is_treatment_results, plot_treatment_results
+
+    folders = [Path(f) for f in ([args.results] if args.results else []) + list(args.compare)]
+    if len(folders) < 2:
+        raise InputError("--compare needs at least two results folders", element="--compare",
+                         expected="nmsm plot --compare TO_RESULTS VO_RESULTS [DO_RESULTS ...]")
+    for folder in folders:
+        if not is_treatment_results(folder):
+            raise InputError("not a Tracking, Verification or Design Optimization results folder", file=folder,
+                             expected="a folder with <trial>_states.sto and IKData/ (written by TO, VO or DO)")
+    if args.output:
+        target = check_output_folder(args.output, what="a folder for the figures (default: <first folder>/plots)")
+    else:
+        target = folders[0] / "plots"
+        check_default_folder_writable(target if target.is_dir() else folders[0], "the figures (<folder>/plots)")
+    with staged_outputs() as staged:
+        drawn = plot_treatment_results(folders[0], staged.folder(target), compare=folders[1:], prefix="compare_")
+    print(f"treatment  {' vs '.join(str(f) for f in folders)}: {len(drawn)} figure(s) in {target}")
+    return 0
+
+
 def _plot(args: argparse.Namespace) -> int:
     """``nmsm plot``: ``-o`` checked first (a folder, or a new one in an existing folder); the
     folders it created for a results folder that failed are removed again (:func:`plot_tree`)."""
     from nmsm.errors import InputError
     from nmsm.io.output_file import check_default_folder_writable, check_output_folder
 
+    if args.compare:
+        return _compare(args)
+    if args.results is None:
+        raise InputError("no results folder given", expected="nmsm plot RESULTS_DIR (or nmsm plot --compare A B ...)")
     root = Path(args.results)
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
@@ -126,6 +157,9 @@ def _plot(args: argparse.Namespace) -> int:
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser("plot", help="figures of every results folder in a tree (PNG)")
-    p.add_argument("results", help="a results folder or a pipeline results tree")
+    p.add_argument("results", nargs="?", help="a results folder or a pipeline results tree")
+    p.add_argument("--compare", nargs="+", metavar="FOLDER", default=[],
+                   help="TO/VO/DO results folders drawn on the figures of the first (RESULTS, or the first of these): "
+                        "nmsm plot --compare to vo do")
     p.add_argument("-o", "--output", help="write the figures here (default: <each folder>/plots)")
     p.set_defaults(func=_plot)

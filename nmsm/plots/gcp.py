@@ -27,17 +27,13 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxContactSurface, read_osimx
 from nmsm.io.storage import Table, read_storage
+from nmsm.plots import style
 
 _FOOT = re.compile(r"_Foot_(\d+)_optimizedGroundReactions\.sto$")
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return style.pyplot()
 
 
 def _foot_files(folder: Path) -> dict[int, str]:
@@ -56,16 +52,16 @@ def plot_reactions(modeled: Table, experimental: Table, columns: tuple[str, ...]
     plt = _pyplot()
     fig, axes = plt.subplots(1, len(columns), figsize=(4 * len(columns), 3.4))
     for ax, column in zip(np.atleast_1d(axes), columns):
-        ax.plot(experimental.time, experimental.column(column), "k-", label="experimental")
-        ax.plot(modeled.time, modeled.column(column), "r--", label="modeled")
+        ax.plot(experimental.time, experimental.column(column), label="experimental", **style.EXPERIMENTAL)
+        ax.plot(modeled.time, modeled.column(column), label="modeled", **style.SOLUTION)
         rms = float(np.sqrt(np.mean((modeled.column(column) - experimental.column(column)) ** 2)))
         ax.set_title(f"{column} (RMS error {rms:.3g} {unit})")
         ax.set_xlabel("time (s)")
         ax.set_ylabel(unit)
-    np.atleast_1d(axes)[0].legend(fontsize=8)
     fig.suptitle(title)
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 
@@ -76,15 +72,16 @@ def plot_kinematics(optimized: Table, experimental: Table, path: Path, title: st
     fig, axes = plt.subplots(2, 4, figsize=(15, 6))
     for k, (ax, label) in enumerate(zip(axes.ravel(), optimized.labels)):
         factor, unit = (180.0 / np.pi, "deg") if k < 4 else (1000.0, "mm")
-        ax.plot(experimental.time, factor * experimental.data[:, k], "k-", label="experimental")
-        ax.plot(optimized.time, factor * optimized.data[:, k], "r--", label="optimized")
-        ax.set_title(f"{label} ({unit})")
+        ax.plot(experimental.time, factor * experimental.data[:, k], label="experimental", **style.EXPERIMENTAL)
+        ax.plot(optimized.time, factor * optimized.data[:, k], label="optimized", **style.SOLUTION)
+        ax.set_title(label)
+        ax.set_ylabel(unit)
         ax.set_xlabel("time (s)")
     axes.ravel()[-1].axis("off")
-    axes.ravel()[0].legend(fontsize=8)
     fig.suptitle(title)
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 
@@ -141,8 +138,9 @@ def plot_stiffness(surface: OsimxContactSurface, path: Path, title: str,
     ax.set_aspect("equal")
     note = "" if toes_pose is not None or not on_toes_a.any() else " (toes springs in the toes frame)"
     ax.set_title(title + note + "\nred edge: toes springs", fontsize=9)
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 

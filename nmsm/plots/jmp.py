@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from nmsm.io.storage import read_storage
+from nmsm.plots import style
 
 RESULTS_FILE = "jmp_results.json"
 
@@ -31,12 +32,7 @@ def is_jmp_results(folder: str | os.PathLike[str]) -> bool:
 
 
 def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return style.pyplot()
 
 
 def _task_figure(plt: Any, folder: Path, task: dict[str, Any], target: Path) -> Path:
@@ -55,14 +51,14 @@ def _task_figure(plt: Any, folder: Path, task: dict[str, Any], target: Path) -> 
     bars.set_xticks(x, names, rotation=60, ha="right", fontsize=8)
     bars.set_ylabel("marker distance error (mm)")
     bars.set_title(task["label"])
-    bars.legend(fontsize=8, ncol=2)
+    bars.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
     lines.plot(before.time, np.sqrt(np.nanmean(mm_before**2, axis=1)), color="#c44e52", label="before")
     lines.plot(after.time, np.sqrt(np.nanmean(mm_after**2, axis=1)), color="#4c72b0", label="after")
     lines.set_xlabel("time (s)")
     lines.set_ylabel("RMS over markers (mm)")
-    lines.legend(fontsize=8)
+    lines.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.tight_layout()
-    fig.savefig(target, dpi=110)
+    fig.savefig(target)
     plt.close(fig)
     return target
 
@@ -84,9 +80,9 @@ def _summary_figure(plt: Any, tasks: list[dict[str, Any]], target: Path) -> Path
     ax.set_xticks(x, labels, fontsize=7)
     ax.set_ylabel("RMS marker distance error (mm)")
     ax.set_title("Joint Model Personalization")
-    ax.legend()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.tight_layout()
-    fig.savefig(target, dpi=110)
+    fig.savefig(target)
     plt.close(fig)
     return target
 

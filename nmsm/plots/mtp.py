@@ -6,19 +6,37 @@ written to ``RESULTS_DIR/plots`` unless ``output_dir`` is given), one set per tr
 
 ``mtp_<trial>_moments.png``       inverse-dynamics vs model joint moments per coordinate
                                   (with synergy extrapolation also the SynX moments), N m
-``mtp_<trial>_activations.png``   muscle activations (SynX ones dashed when present)
+``mtp_<trial>_activations.png``   muscle activations with the processed EMG they come from
+                                  (``muscleExcitations``: EMG delayed and scaled) dashed, and
+                                  the SynX activations when present
 ``mtp_<trial>_fiber_lengths.png`` normalized fiber lengths with the 0.3 / 1.3 limits
 ``mtp_passive_moments.png``       passive trials: experimental vs modeled moments (N m)
+``mtp_parameters.png``            the personalized parameters of each muscle (the ``.osimx``)
+                                  within their bounds; values at a bound in red
+
+Style, axes and legends: :mod:`nmsm.plots.style`.
 """
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from nmsm.io.storage import Table, read_storage
+from nmsm.plots import style
+
+#: parameter charts: osimx attribute, title, factor from the .osimx's unit (0.1 s, 0.01 s,
+#: -) to the shown one, bounds in the shown unit (MTP's design bounds,
+#: :data:`nmsm.tools.mtp.problem.BLOCKS`)
+PARAMETERS = (
+    ("electromechanical_delay", "electromechanical delay (ms)", 100.0, (0.0, 125.0)),
+    ("activation_time_constant", "activation time constant (ms)", 10.0, (7.5, 35.0)),
+    ("activation_nonlinearity_constant", "activation nonlinearity (-)", 1.0, (0.0, 0.35)),
+    ("emg_scale_factor", "EMG scale (-)", 1.0, (0.05, 1.0)),
+)
 
 
 def is_mtp_results(folder: str | os.PathLike[str]) -> bool:
@@ -27,12 +45,7 @@ def is_mtp_results(folder: str | os.PathLike[str]) -> bool:
 
 
 def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return style.pyplot()
 
 
 def _tables(folder: Path, quantity: str) -> dict[str, Table]:
@@ -49,8 +62,7 @@ def _tables(folder: Path, quantity: str) -> dict[str, Table]:
 
 
 def _grid(n: int) -> tuple[int, int]:
-    cols = min(3, max(1, n))
-    return math.ceil(n / cols), cols
+    return style.grid(n)
 
 
 def _moments_figure(plt: Any, trial: str, measured: Table, model: Table, synx: Table | None, out: Path) -> Path:
@@ -58,9 +70,9 @@ def _moments_figure(plt: Any, trial: str, measured: Table, model: Table, synx: T
     rows, cols = _grid(len(labels))
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.0 * rows), squeeze=False)
     for ax, label in zip(axes.flat, labels):
-        ax.plot(measured.time, measured.column(label), "k", lw=2, label="inverse dynamics")
+        ax.plot(measured.time, measured.column(label), label="inverse dynamics", **style.EXPERIMENTAL)
         if model.has(label):
-            ax.plot(model.time, model.column(label), "C0", label="model (EMG)")
+            ax.plot(model.time, model.column(label), label="model (EMG)", **style.SOLUTION)
         if synx is not None and synx.has(label):
             ax.plot(synx.time, synx.column(label), "C1--", label="model (SynX)")
         ax.set_title(label)
@@ -68,36 +80,60 @@ def _moments_figure(plt: Any, trial: str, measured: Table, model: Table, synx: T
         ax.set_ylabel("moment (N m)")
     for ax in list(axes.flat)[len(labels):]:
         ax.axis("off")
-    axes.flat[0].legend(fontsize=8)
-    fig.suptitle(f"{trial}: joint moments")
-    fig.tight_layout()
-    path = out / f"mtp_{trial}_moments.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return style.save(plt, fig, out / f"mtp_{trial}_moments.png", f"{trial}: joint moments")
 
 
 def _muscle_figure(plt: Any, trial: str, table: Table, extra: Table | None, what: str, ylabel: str,
-                   limits: tuple[float, ...], out: Path) -> Path:
+                   limits: tuple[float, ...], out: Path, emg: Table | None = None) -> Path:
     labels = list(table.labels)
     rows, cols = _grid(len(labels))
     fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 2.4 * rows), squeeze=False)
     for ax, label in zip(axes.flat, labels):
-        ax.plot(table.time, table.column(label), "C0")
+        if emg is not None and emg.has(label):
+            ax.plot(emg.time, emg.column(label), label="processed EMG (delayed, scaled)", **style.EXPERIMENTAL)
+        ax.plot(table.time, table.column(label), label=what.rstrip("s") if what == "activations" else what,
+                **style.SOLUTION)
         if extra is not None and extra.has(label):
-            ax.plot(extra.time, extra.column(label), "C1--")
+            ax.plot(extra.time, extra.column(label), color="C1", label="SynX activation")
         for y in limits:
             ax.axhline(y, color="0.6", lw=0.8, ls=":")
-        ax.set_title(label, fontsize=9)
-        ax.set_ylabel(ylabel, fontsize=8)
+        ax.set_title(label)
+        ax.set_ylabel(ylabel)
+        ax.set_xlabel(style.TIME)
     for ax in list(axes.flat)[len(labels):]:
         ax.axis("off")
-    fig.suptitle(f"{trial}: {what}")
-    fig.tight_layout()
-    path = out / f"mtp_{trial}_{what.replace(' ', '_')}.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return style.save(plt, fig, out / f"mtp_{trial}_{what.replace(' ', '_')}.png", f"{trial}: {what}")
+
+
+def _parameters_figure(plt: Any, osimx_file: Path, out: Path) -> Path | None:
+    """Each personalized parameter per muscle as a dot within its bounds (grey band); dots
+    within 0.1 % of the range from a bound in red."""
+    from nmsm.io.osimx import read_osimx
+
+    muscles = read_osimx(osimx_file).muscles
+    names = list(muscles)
+    shown = [(attr, title, factor, bounds) for attr, title, factor, bounds in PARAMETERS
+             if any(getattr(muscles[m], attr, None) is not None for m in names)]
+    if not names or not shown:
+        return None
+    fig, axes = plt.subplots(1, len(shown), figsize=(3.2 * len(shown), 0.28 * len(names) + 1.4), squeeze=False,
+                             sharey=True)
+    y = np.arange(len(names))
+    for ax, (attr, title, factor, (low, high)) in zip(axes.flat, shown):
+        values = np.array([np.nan if getattr(muscles[m], attr, None) is None else factor * getattr(muscles[m], attr)
+                           for m in names])
+        at_bound = np.minimum(np.abs(values - low), np.abs(values - high)) <= 1e-3 * (high - low)
+        ax.axvspan(low, high, color="0.92", zorder=0)
+        for edge in (low, high):
+            ax.axvline(edge, color="0.5", lw=0.8, ls=":")
+        ax.plot(values[~at_bound], y[~at_bound], "o", ms=4, label="within the bounds", **{"color": "C0"})
+        ax.plot(values[at_bound], y[at_bound], "o", ms=5, color="C3", label="at a bound")
+        ax.set_title(title)
+        ax.set_xlim(low - 0.08 * (high - low), high + 0.08 * (high - low))
+    axes.flat[0].set_yticks(y, names)
+    axes.flat[0].invert_yaxis()
+    return style.save(plt, fig, out / "mtp_parameters.png", f"personalized muscle parameters ({osimx_file.name}; "
+                      "grey: MTP's bounds)")
 
 
 def _passive_figure(plt: Any, experimental: dict[str, Table], modeled: dict[str, Table], out: Path) -> Path:
@@ -114,18 +150,12 @@ def _passive_figure(plt: Any, experimental: dict[str, Table], modeled: dict[str,
             ax.plot(exp.time, values, color=f"C{j}", lw=2, label=f"{label} experimental")
             if mod is not None and mod.has(label):
                 ax.plot(mod.time, mod.column(label), color=f"C{j}", ls="--", label=f"{label} modeled")
-        ax.set_title(name, fontsize=9)
+        ax.set_title(name)
         ax.set_xlabel("frame")
         ax.set_ylabel("moment (N m)")
-        ax.legend(fontsize=6)
     for ax in list(axes.flat)[len(names):]:
         ax.axis("off")
-    fig.suptitle("passive joint moments")
-    fig.tight_layout()
-    path = out / "mtp_passive_moments.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return style.save(plt, fig, out / "mtp_passive_moments.png", "passive joint moments")
 
 
 def plot_mtp_results(results_dir: str | os.PathLike[str], output_dir: str | os.PathLike[str] | None = None) -> list[Path]:
@@ -140,17 +170,23 @@ def plot_mtp_results(results_dir: str | os.PathLike[str], output_dir: str | os.P
     synx = _tables(folder, "modelJointMomentsSynx")
     activations = _tables(folder, "muscleActivations")
     synx_activations = _tables(folder, "muscleActivationsSynx")
+    excitations = _tables(folder, "muscleExcitations")
     lengths = _tables(folder, "normalizedFiberLengths")
     for trial, table in measured.items():
         if trial in model:
             written.append(_moments_figure(plt, trial, table, model[trial], synx.get(trial), out))
         if trial in activations:
             written.append(_muscle_figure(plt, trial, activations[trial], synx_activations.get(trial),
-                                          "activations", "activation", (0.0, 1.0), out))
+                                          "activations", "activation (-)", (0.0, 1.0), out, excitations.get(trial)))
         if trial in lengths:
             written.append(_muscle_figure(plt, trial, lengths[trial], None, "fiber lengths",
-                                          "normalized length", (0.3, 1.3), out))
+                                          "normalized fiber length (-)", (0.3, 1.3), out))
     experimental = _tables(folder, "passiveJointMomentsExperimental")
     if experimental:
         written.append(_passive_figure(plt, experimental, _tables(folder, "passiveJointMomentsModeled"), out))
+    osimx_files = sorted(folder.glob("*.osimx"))
+    if osimx_files:
+        chart = _parameters_figure(plt, osimx_files[0], out)
+        if chart is not None:
+            written.append(chart)
     return written

@@ -29,6 +29,7 @@ import numpy as np
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, read_storage
 from nmsm.io.trials import find_trial_file
+from nmsm.plots import style
 
 _WEIGHTS = "synergyWeights.sto"
 _COMMANDS = "_synergyCommands.sto"
@@ -36,12 +37,7 @@ _MOMENTS = "modelMoments"
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return style.pyplot()
 
 
 def _percent(table: Table) -> np.ndarray:
@@ -85,8 +81,9 @@ def plot_synergy_vectors(weights: Table, command_labels: Sequence[str], path: Pa
         for k in range(len(rows), n_rows):
             axes[k, g].axis("off")
     fig.suptitle("Synergy vectors (largest weight 1)")
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 
@@ -98,12 +95,12 @@ def plot_commands(commands: Table, path: Path, trial: str) -> Path:
     x = _percent(commands)
     for j, label in enumerate(commands.labels):
         ax.plot(x, commands.data[:, j], label=label)
-    ax.set_xlabel("cycle (%)")
-    ax.set_ylabel("synergy command")
+    ax.set_xlabel(style.PERCENT_CYCLE)
+    ax.set_ylabel("synergy command (-)")
     ax.set_title(f"{trial}: synergy commands")
-    ax.legend(fontsize=7, ncol=2)
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 
@@ -117,22 +114,24 @@ def plot_moment_matching(ncp: Table, combined: Table | None, inverse_dynamics: T
     for j, label in enumerate(ncp.labels):
         ax = axes.flat[j]
         if inverse_dynamics is not None and inverse_dynamics.has(label):
-            ax.plot(_percent(inverse_dynamics), inverse_dynamics.column(label), "k", lw=2, label="inverse dynamics")
-        ax.plot(x, ncp.data[:, j], "tab:blue", label="NCP")
+            ax.plot(_percent(inverse_dynamics), inverse_dynamics.column(label), label="inverse dynamics",
+                    **style.EXPERIMENTAL)
+        ax.plot(x, ncp.data[:, j], label="NCP", **style.SOLUTION)
         if combined is not None and combined.has(label):
             ax.plot(_percent(combined), combined.column(label), "tab:orange", ls="--", label="MTP + NCP")
         if inverse_dynamics is not None and inverse_dynamics.has(label):
             rms = float(np.sqrt(np.mean((ncp.data[:, j] - inverse_dynamics.column(label)) ** 2)))
-            ax.set_title(f"{label} (RMS {rms:.2f})", fontsize=8)
+            ax.set_title(f"{label} (RMS {rms:.2f} N·m)")
         else:
-            ax.set_title(label, fontsize=8)
-        ax.tick_params(labelsize=7)
+            ax.set_title(label)
+        ax.set_xlabel(style.PERCENT_CYCLE)
+        ax.set_ylabel("N·m")
     for k in range(ncp.n_columns, rows * cols):
         axes.flat[k].axis("off")
-    axes.flat[0].legend(fontsize=6)
     fig.suptitle(f"{trial}: joint moments (N·m)")
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path)
     plt.close(fig)
     return path
 
@@ -147,17 +146,18 @@ def plot_activation_matching(ncp_activations: np.ndarray, muscles: Sequence[str]
     for i, muscle in enumerate(muscles):
         ax = axes.flat[i]
         if mtp is not None and mtp.has(muscle):
-            ax.plot(_percent(mtp), mtp.column(muscle), "k", lw=2, label="MTP")
-        ax.plot(x, ncp_activations[:, i], "tab:blue", label="NCP")
+            ax.plot(_percent(mtp), mtp.column(muscle), label="MTP", **style.EXPERIMENTAL)
+        ax.plot(x, ncp_activations[:, i], label="NCP", **style.SOLUTION)
         ax.set_title(muscle, fontsize=7)
+        ax.set_xlabel(style.PERCENT_CYCLE, fontsize=6)
         ax.set_ylim(bottom=min(0.0, float(ncp_activations[:, i].min())))
         ax.tick_params(labelsize=6)
     for k in range(len(muscles), rows * cols):
         axes.flat[k].axis("off")
-    axes.flat[0].legend(fontsize=6)
     fig.suptitle(f"{trial}: muscle activations")
+    style.legend_below(fig)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    fig.savefig(path)
     plt.close(fig)
     return path
 

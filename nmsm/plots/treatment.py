@@ -1,29 +1,44 @@
 """Figures of a Tracking/Verification/Design Optimization results folder.
 
-``nmsm plot RESULTS_DIR`` can call :func:`plot_treatment_results` when
-:func:`is_treatment_results` is true for the folder. Figures (PNG, written to
-``RESULTS_DIR/plots`` unless ``output_dir`` is given):
+``nmsm plot RESULTS_DIR`` calls :func:`plot_treatment_results` when
+:func:`is_treatment_results` is true for the folder; ``nmsm plot --compare A B C`` draws A's
+figures with B and C overlaid. Figures (PNG, written to ``RESULTS_DIR/plots`` unless
+``output_dir`` is given):
 
-``<trial>_kinematics.png``   state coordinates: modeled vs tracked positions (deg for
-                             rotational), speeds and accelerations (``Analysis/`` files)
-``<trial>_loads.png``        inverse dynamics of the solution (``IDData``) for the controlled
-                             coordinates, with torque controls when present
-``<trial>_controls.png``     torque controls and/or synergy commands
-``<trial>_activations.png``  combined muscle activations (synergy control)
+``<trial>_kinematics.png``        state coordinates (deg or m) and speeds (deg/s or m/s) of the
+                                  solution through the collocation polynomial
+                                  (``Analysis/<trial>_statesInterpolated.sto``, the nodes as dots;
+                                  the nodes alone when that file is missing), the tracked data
+                                  dashed (``_trackedInterpolated.sto``)
+``<trial>_loads.png``             inverse dynamics of the solution (``IDData``, N·m or N) on the
+                                  controlled coordinates, with the torque controls
+``<trial>_controls.png``          torque controls (N·m or N); ``_controls_synergy.png`` synergy commands
+``<trial>_activations.png``       combined muscle activations
+``<trial>_ground_reactions.png``  modeled ground reactions (``GRFData``, N), with the tracked
+                                  ones dashed when the tracked-quantities folder named in the
+                                  results' settings copy is found
+``<trial>_convergence.png``       objective and constraint violation per IPOPT iteration
+                                  (``<trial>_ipopt.log``)
 
-``compare``: other results folders (e.g. the original pipeline's) drawn dashed on the same
-axes, matched by column label.
+The x axis is percent of the gait cycle for trials with ground contact (a ``GRFData``
+folder: the trial is a gait cycle), time (s) otherwise. ``compare``: other results folders
+(e.g. the original pipeline's, or VO and DO against TO) drawn on the same axes, matched by
+column label and named by folder.
 """
 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
+import attrs
 import numpy as np
 
-from nmsm.io.storage import Table, read_storage
+from nmsm.io.storage import Table, read_storage, strip_load_suffix
+from nmsm.plots import style
 
 
 def _trial(folder: Path) -> str | None:
@@ -38,59 +53,173 @@ def is_treatment_results(folder: str | os.PathLike[str]) -> bool:
 
 
 def _read(path: Path) -> Table | None:
-    return read_storage(path) if path.is_file() else None
+    return read_storage(path, allow_nan=lambda label: True) if path.is_file() else None
 
 
-def _grid(n: int) -> tuple[int, int]:
-    cols = min(n, 3)
-    return (n + cols - 1) // cols, cols
+@attrs.frozen
+class Run:
+    """A results folder drawn on the figures: its name in legends and its line style."""
+
+    folder: Path
+    name: str
+    style: dict[str, Any]
+
+    def table(self, relative: str) -> Table | None:
+        return _read(self.folder / relative)
 
 
-def _plot_columns(ax_list, tables: Sequence[tuple[Table | None, str, dict]], labels: Sequence[str],
-                  scale: dict[str, float] | None = None) -> None:
-    for ax, label in zip(ax_list, labels):
-        for table, name, style in tables:
-            if table is None or not table.has(label):
+@attrs.frozen
+class Axis:
+    """The x axis of a trial's figures: percent of ``[start, end]`` s or time."""
+
+    gait_cycle: bool
+    start: float
+    end: float
+
+    def x(self, time: np.ndarray) -> np.ndarray:
+        return style.cycle_axis(time, self.gait_cycle, self.start, self.end)[0]
+
+    @property
+    def label(self) -> str:
+        return style.PERCENT_CYCLE if self.gait_cycle else style.TIME
+
+
+def _rotational(label: str) -> bool:
+    """Model-free guess used for units: coordinates ending in ``_tx``/``_ty``/``_tz`` are translations."""
+    return not strip_load_suffix(label).endswith(("_tx", "_ty", "_tz"))
+
+
+def _series(ax: Any, axis: Axis, runs: Sequence[Run], relative: str, label: str, factor: float = 1.0,
+            nodes: str | None = None) -> None:
+    """Draw column ``label`` of ``relative`` of every run; ``nodes``: the file holding the
+    solution at the nodes, drawn as dots (and as the line when ``relative`` is missing)."""
+    for run in runs:
+        table = run.table(relative)
+        node_table = run.table(nodes) if nodes else None
+        if table is not None and table.has(label):
+            ax.plot(axis.x(table.time), factor * table.column(label), label=run.name, **run.style)
+        elif node_table is not None and node_table.has(label):
+            ax.plot(axis.x(node_table.time), factor * node_table.column(label), label=run.name, **run.style)
+        if node_table is not None and node_table.has(label) and table is not None:
+            ax.plot(axis.x(node_table.time), factor * node_table.column(label), ls="none", marker=".", ms=2.5,
+                    color=run.style.get("color"), label="_nodes")
+
+
+def _reference(ax: Any, axis: Axis, table: Table | None, label: str, factor: float = 1.0,
+               name: str = "tracked") -> None:
+    if table is not None and table.has(label):
+        ax.plot(axis.x(table.time), factor * table.column(label), label=name, **style.EXPERIMENTAL)
+
+
+def _kinematics(plt_fig: tuple, axis: Axis, runs: Sequence[Run], trial: str, coords: Sequence[str]) -> None:
+    _, _, axes = plt_fig
+    dense = runs[0].table(f"Analysis/{trial}_trackedInterpolated.sto")
+    tracked = dense or runs[0].table(f"Analysis/{trial}_trackedPositions.sto")
+    tracked_speeds = runs[0].table(f"Analysis/{trial}_trackedVelocities.sto")
+    if dense is not None:
+        tracked_speeds = attrs.evolve(dense, labels=tuple(label.removesuffix("_u") if label.endswith("_u") else
+                                                          f"{label}_position" for label in dense.labels))
+    for j, c in enumerate(coords):
+        rot = _rotational(c)
+        factor = float(np.degrees(1.0)) if rot else 1.0
+        top, bottom = axes[j], axes[len(coords) + j]
+        _series(top, axis, runs, f"Analysis/{trial}_statesInterpolated.sto", c, factor, f"{trial}_states.sto")
+        _reference(top, axis, tracked, c, factor)
+        top.set_title(c)
+        top.set_ylabel("deg" if rot else "m")
+        speed = f"{c}_u"
+        _series(bottom, axis, runs, f"Analysis/{trial}_statesInterpolated.sto", speed, factor, f"{trial}_states.sto")
+        _reference(bottom, axis, tracked_speeds, c, factor)
+        bottom.set_title(f"{c} speed")
+        bottom.set_ylabel("deg/s" if rot else "m/s")
+        bottom.set_xlabel(axis.label)
+
+
+def _load_unit(label: str) -> str:
+    return "N" if label.endswith("_force") or not _rotational(label) else "N·m"
+
+
+def _columns_figure(path: Path, title: str, axis: Axis, runs: Sequence[Run], relative: str, labels: Sequence[str],
+                    unit: Any, extra: Any = None) -> Path:
+    plt, fig, axes = style.panels(len(labels))
+    for ax, label in zip(axes, labels):
+        _series(ax, axis, runs, relative, label)
+        if extra is not None:
+            extra(ax, label)
+        ax.set_title(label)
+        ax.set_ylabel(unit(label) if callable(unit) else unit)
+        ax.set_xlabel(axis.label)
+    return style.save(plt, fig, path, title)
+
+
+def ipopt_iterations(path: Path) -> np.ndarray:
+    """(n, 3) iteration, objective, constraint violation (``inf_pr``) of an IPOPT log's table."""
+    rows = []
+    pattern = re.compile(r"^\s*(\d+)r?\s+(\S+)\s+(\S+)\s+\S+\s")
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+        match = pattern.match(line)
+        if match:
+            try:
+                rows.append((float(match.group(1)), float(match.group(2)), float(match.group(3))))
+            except ValueError:
                 continue
-            factor = (scale or {}).get(label, 1.0)
-            ax.plot(table.time, table.column(label) * factor, label=name, **style)
-        ax.set_title(label, fontsize=9)
-        ax.tick_params(labelsize=7)
-    for ax in ax_list[len(labels):]:
-        ax.axis("off")
+    return np.array(rows).reshape(-1, 3)
 
 
-def _figure(n: int):
-    import matplotlib
+def plot_convergence(log: Path, path: Path, title: str) -> Path | None:
+    """Objective and constraint violation per IPOPT iteration of ``log``; None without iterations."""
+    table = ipopt_iterations(log)
+    if table.shape[0] == 0:
+        return None
+    plt, fig, (cost, violation) = style.panels(2, columns=2, size=(4.5, 3.0))
+    cost.semilogy(table[:, 0], np.abs(table[:, 1]) + 1e-300, **style.SOLUTION, label="objective")
+    cost.set_ylabel("objective (scaled)")
+    violation.semilogy(table[:, 0], table[:, 2] + 1e-300, color="C3", label="constraint violation")
+    violation.set_ylabel("largest constraint violation")
+    for ax in (cost, violation):
+        ax.set_xlabel("IPOPT iteration")
+    return style.save(plt, fig, path, title)
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    rows, cols = _grid(max(n, 1))
-    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 2.6 * rows), squeeze=False)
-    return plt, fig, list(axes.ravel())
+def _tracked_folder(folder: Path) -> Path | None:
+    """The tracked-quantities folder named in the settings copy of a results folder, when it exists."""
+    from lxml import etree
+
+    for settings in sorted(folder.glob("*.xml")):
+        try:
+            root = etree.parse(str(settings)).getroot()
+        except (etree.XMLSyntaxError, OSError):
+            continue
+        for element in root.iter("tracked_quantities_directory"):
+            text = (element.text or "").strip()
+            for base in (folder, folder.parent):
+                candidate = (base / text).resolve()
+                if text and candidate.is_dir():
+                    return candidate
+    return None
 
 
-def _save(plt, fig, path: Path, title: str) -> Path:
-    fig.suptitle(title, fontsize=10)
-    handles, labels = [], []
-    for ax in fig.axes:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            if lab not in labels:
-                handles.append(h)
-                labels.append(lab)
-    if handles:
-        fig.legend(handles, labels, loc="lower right", fontsize=8)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+def _ground_reactions(path: Path, title: str, axis: Axis, runs: Sequence[Run], trial: str) -> Path | None:
+    modeled = runs[0].table(f"GRFData/{trial}.sto")
+    if modeled is None:
+        return None
+    forces = [label for label in modeled.labels if re.search(r"(force_v[xyz]|_F[xyz]|_v[xyz])$", label)]
+    forces = forces or list(modeled.labels[:3])
+    tracked_folder = _tracked_folder(runs[0].folder)
+    tracked = _read(tracked_folder / "GRFData" / f"{trial}.sto") if tracked_folder is not None else None
+    if tracked is not None:
+        tracked = attrs.evolve(tracked, time=tracked.time - tracked.time[0] + modeled.time[0])
+
+    def experimental(ax: Any, label: str) -> None:
+        _reference(ax, axis, tracked, label, name="experimental")
+
+    return _columns_figure(path, title, axis, runs, f"GRFData/{trial}.sto", forces, "N", experimental)
 
 
 def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str | os.PathLike[str] | None = None,
-                           compare: Sequence[str | os.PathLike[str]] = ()) -> list[Path]:
-    """Write the figures listed in the module docstring; returns their paths."""
+                           compare: Sequence[str | os.PathLike[str]] = (), *, prefix: str = "") -> list[Path]:
+    """Write the figures listed in the module docstring (file names preceded by ``prefix``);
+    returns their paths."""
     folder = Path(results_dir)
     trial = _trial(folder)
     if trial is None:
@@ -98,58 +227,54 @@ def plot_treatment_results(results_dir: str | os.PathLike[str], output_dir: str 
     out_dir = Path(output_dir) if output_dir is not None else folder / "plots"
     # a failed solve's last iterate (``last_iterate/`` with its diagnosis) must not look converged
     note = " - LAST ITERATE, NOT CONVERGED (diagnosis.txt)" if (folder / "diagnosis.txt").is_file() else ""
-
-    def save(plt, fig, path: Path, title: str) -> Path:
-        return _save(plt, fig, path, title + note)
-
-    others = [Path(c) for c in compare]
-    written: list[Path] = []
+    names = [folder.resolve().name] + [Path(c).resolve().name for c in compare]
+    if len(set(names)) < len(names):  # folders of the same name: the path relative to the common parent
+        common = Path(os.path.commonpath([str(folder.resolve())] + [str(Path(c).resolve()) for c in compare]))
+        names = [str(Path(f).resolve().relative_to(common)) or Path(f).name for f in [folder, *compare]]
+    runs = [Run(folder, names[0], style.SOLUTION)]
+    runs += [Run(Path(c), name, {"color": style.COMPARED_COLORS[k % len(style.COMPARED_COLORS)]})
+             for k, (c, name) in enumerate(zip(compare, names[1:]))]
     states = read_storage(folder / f"{trial}_states.sto")
+    axis = Axis((folder / "GRFData").is_dir(), float(states.time[0]), float(states.time[-1]))
+    what = " vs ".join(names) if compare else names[0]
+
+    def target(name: str) -> Path:
+        return out_dir / f"{prefix}{trial}_{name}.png"
+
+    written: list[Path] = []
     coords = [label for label in states.labels if not label.endswith("_u")]
-    degrees = {c: 180.0 / np.pi for c in coords}
-    # kinematics: modeled vs tracked
-    kinds = ("Positions", "Velocities", "Accelerations")
-    plt, fig, axes = _figure(3 * len(coords))
-    for row, kind in enumerate(kinds):
-        modeled = _read(folder / "Analysis" / f"{trial}_modeled{kind}.sto")
-        tracked = _read(folder / "Analysis" / f"{trial}_tracked{kind}.sto")
-        series = [(modeled, "modeled", {"color": "C0"}), (tracked, "tracked", {"color": "k", "ls": ":"})]
-        series += [(_read(o / "Analysis" / f"{trial}_modeled{kind}.sto"), o.name, {"ls": "--"}) for o in others]
-        _plot_columns(axes[row * len(coords):(row + 1) * len(coords)], series, coords, degrees)
-        for ax in axes[row * len(coords):(row + 1) * len(coords)]:
-            ax.set_ylabel({"Positions": "deg", "Velocities": "deg/s", "Accelerations": "deg/s²"}[kind], fontsize=8)
-    written.append(save(plt, fig, out_dir / f"{trial}_kinematics.png", f"{trial}: state kinematics"))
-    # loads
-    ids = _read(folder / "IDData" / f"{trial}.sto")
-    torque = _read(folder / f"{trial}_torqueControls.sto")
+    fig = style.panels(2 * len(coords))
+    _kinematics(fig, axis, runs, trial, coords)
+    written.append(style.save(fig[0], fig[1], target("kinematics"), f"{trial}: state kinematics ({what}){note}"))
+    ids = runs[0].table(f"IDData/{trial}.sto")
+    torque = runs[0].table(f"{trial}_torqueControls.sto")
     if ids is not None:
-        loads = [label for label in ids.labels if any(label.startswith(c + "_") for c in coords)]
-        plt, fig, axes = _figure(len(loads))
-        series = [(ids, "inverse dynamics", {"color": "C0"})]
-        series += [(_read(o / "IDData" / f"{trial}.sto"), o.name, {"ls": "--"}) for o in others]
-        _plot_columns(axes, series, loads)
-        if torque is not None:
-            for ax, label in zip(axes, loads):
-                coord = label.rsplit("_", 1)[0]
-                if torque.has(coord):
-                    ax.plot(torque.time, torque.column(coord), color="C1", ls=":", label="torque control")
-        written.append(save(plt, fig, out_dir / f"{trial}_loads.png", f"{trial}: joint loads (N·m, N)"))
-    # controls
-    commands = _read(folder / f"{trial}_synergyCommands.sto")
-    for table, name in ((torque, "torque controls"), (commands, "synergy commands")):
-        if table is None:
-            continue
-        plt, fig, axes = _figure(table.n_columns)
-        fname = f"{trial}_{'torqueControls' if table is torque else 'synergyCommands'}.sto"
-        series = [(table, "solution", {"color": "C0"})] + [(_read(o / fname), o.name, {"ls": "--"}) for o in others]
-        _plot_columns(axes, series, table.labels)
-        written.append(save(plt, fig, out_dir / f"{trial}_controls{'' if table is torque else '_synergy'}.png",
-                             f"{trial}: {name}"))
-    activations = _read(folder / f"{trial}_combinedActivations.sto")
+        loads = [label for label in ids.labels if strip_load_suffix(label) in coords]
+
+        def torque_control(ax: Any, label: str) -> None:
+            coordinate = strip_load_suffix(label)
+            if torque is not None and torque.has(coordinate):
+                ax.plot(axis.x(torque.time), torque.column(coordinate), color="C1", ls=":", label="torque control")
+
+        written.append(_columns_figure(target("loads"), f"{trial}: joint loads ({what}){note}", axis, runs,
+                                       f"IDData/{trial}.sto", loads, _load_unit, torque_control))
+    for file, name, title, unit in ((f"{trial}_torqueControls.sto", "controls", "torque controls", _load_unit),
+                                    (f"{trial}_synergyCommands.sto", "controls_synergy", "synergy commands", "-")):
+        table = runs[0].table(file)
+        if table is not None:
+            written.append(_columns_figure(target(name), f"{trial}: {title} ({what}){note}", axis, runs, file,
+                                           table.labels, unit))
+    activations = runs[0].table(f"{trial}_combinedActivations.sto")
     if activations is not None:
-        plt, fig, axes = _figure(activations.n_columns)
-        fname = f"{trial}_combinedActivations.sto"
-        series = [(activations, "solution", {"color": "C0"})] + [(_read(o / fname), o.name, {"ls": "--"}) for o in others]
-        _plot_columns(axes, series, activations.labels)
-        written.append(save(plt, fig, out_dir / f"{trial}_activations.png", f"{trial}: muscle activations"))
+        written.append(_columns_figure(target("activations"), f"{trial}: muscle activations ({what}){note}", axis,
+                                       runs, f"{trial}_combinedActivations.sto", activations.labels, "activation (-)"))
+    reactions = _ground_reactions(target("ground_reactions"), f"{trial}: ground reactions ({what}){note}", axis, runs,
+                                  trial)
+    if reactions is not None:
+        written.append(reactions)
+    log = folder / f"{trial}_ipopt.log"
+    if log.is_file():
+        figure = plot_convergence(log, target("convergence"), f"{trial}: IPOPT convergence ({names[0]}){note}")
+        if figure is not None:
+            written.append(figure)
     return written

@@ -10,8 +10,10 @@ embedded as base64 PNG so the page is one file that can be mailed: the PNGs of
 ``<stage>/plots`` when there are any (``nmsm plot``), otherwise drawn by the tool's plot
 module into a temporary folder that is removed once the page is built. The report reads
 the results tree and never writes into it (the page itself goes where it is told, by
-default ``<results>/report.html``). The example adds its known-answer comparison (collapsed,
-under the status table).
+default ``<results>/report.html``). A tree with several treatment stages (TO, VO, DO) ends
+with their comparison: the first one's kinematics and ground reactions with the others
+drawn on them, against the experimental data (:func:`treatment_comparison`). The example
+adds its known-answer comparison (collapsed, under the status table).
 
 The page is rendered with Jinja2 from the templates in ``nmsm/report/templates``:
 ``report.html.j2`` (the page), ``status.html.j2``, ``checks.html.j2``, ``table.html.j2``
@@ -66,6 +68,8 @@ class StageView:
     seconds: float | None = None
     #: the kind shown in the status table (the pipeline's stage kind, e.g. ``to``)
     label: str = ""
+    #: False for sections that are no stage (the treatment comparison): no status row
+    is_stage: bool = True
     status: StageStatus = attrs.field(factory=StageStatus)
     tables: list[ReportTable] = attrs.field(factory=list)
     texts: list[ReportText] = attrs.field(factory=list)
@@ -145,6 +149,31 @@ def _fill(stage: StageView, scratch: Path, log: Callable[[str], None] | None) ->
     stage.figures = [_figure(p) for p in _figures(stage.kind, stage.folder, scratch, log)]
 
 
+def treatment_comparison(stages: Sequence[StageView], scratch: Path, log: Callable[[str], None] | None
+                         ) -> StageView | None:
+    """A section overlaying the treatment stages of one trial (TO, VO, DO, ...) against the
+    experimental data: the first stage's kinematics and ground reactions with the others
+    drawn on them; None with fewer than two such stages."""
+    from nmsm.plots.treatment import is_treatment_results, plot_treatment_results
+
+    runs = [s for s in stages if s.kind == "treatment" and is_treatment_results(s.folder)]
+    if len(runs) < 2:
+        return None
+    try:
+        drawn = plot_treatment_results(runs[0].folder, scratch, compare=[s.folder for s in runs[1:]],
+                                       prefix="compare_")
+    except Exception as exc:  # a figure that cannot be drawn must not lose the rest of the report
+        if log:
+            log(f"report: no comparison figures ({type(exc).__name__}: {exc})")
+        return None
+    shown = [p for p in drawn if p.stem.endswith(("_kinematics", "_ground_reactions"))]
+    names = " vs ".join(s.name for s in runs)
+    view = StageView(f"Treatment comparison: {names}", "comparison", runs[0].folder,
+                     f"{names}, drawn on the figures of {runs[0].name}", is_stage=False)
+    view.figures = [_figure(p) for p in shown]
+    return view
+
+
 def _environment() -> Any:
     import jinja2
 
@@ -186,6 +215,9 @@ def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str]
     with tempfile.TemporaryDirectory(prefix="nmsm-report-") as drawn:
         for k, stage in enumerate(stages):
             _fill(stage, Path(drawn) / str(k), log)
+        comparison = treatment_comparison(stages, Path(drawn) / "comparison", log)
+        if comparison is not None:
+            stages.append(comparison)
         page = render_report(root, stages, checks=checks, title=title)
     target = Path(output) if output is not None else root / REPORT_FILE
     write_output(target, page)

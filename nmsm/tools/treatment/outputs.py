@@ -17,6 +17,11 @@ Files (``<trial>`` = ``trial_name``):
 ``<trial>_convergence.txt``            IPOPT status, cost per term, active/violated constraints
 ``Analysis/<trial>_trackedPositions.sto`` / ``_modeledPositions.sto`` etc.: tracked and
                                        modeled state kinematics on the same times
+``Analysis/<trial>_statesInterpolated.sto`` the states between the nodes through each mesh
+                                       interval's collocation polynomial (:data:`SAMPLES_PER_POINT`
+                                       samples per collocation point; what the figures draw);
+                                       ``_trackedInterpolated.sto`` the tracked kinematics at the
+                                       same times
 """
 
 from __future__ import annotations
@@ -35,6 +40,20 @@ from nmsm.interop.moco_trajectory import (
 from nmsm.io.storage import table_from_columns, write_storage
 from nmsm.tools.treatment.formulation import speed_label
 from nmsm.tools.treatment.solution import TreatmentSolution
+
+
+#: samples of ``Analysis/<trial>_statesInterpolated.sto`` per collocation point of a mesh interval
+SAMPLES_PER_POINT = 4
+
+
+def dense_normalized_times(tsol: TreatmentSolution) -> np.ndarray:
+    """Normalized times in [0, 1]: in each mesh interval :data:`SAMPLES_PER_POINT` evenly
+    spaced points per collocation point of the interval (its start included), then 1."""
+    mesh = tsol.built.trajectory.phase.mesh
+    starts = mesh.interval_starts
+    pieces = [np.linspace(a, b, SAMPLES_PER_POINT * n + 1)[:-1]
+              for a, b, n in zip(starts[:-1], starts[1:], mesh.points)]
+    return np.concatenate([*pieces, [1.0]])
 
 
 def write_table(path: Path, time: np.ndarray, labels: Sequence[str], values: np.ndarray, name: str = "") -> Path:
@@ -80,6 +99,15 @@ def write_solution(stage: Path, tsol: TreatmentSolution, *, summary: str | None 
         else:
             time = t if values.shape[0] == t.size else np.arange(1.0, values.shape[0] + 1)
         out.append(write_table(stage / name, time, labels, values))
+    s_dense = dense_normalized_times(tsol)
+    dense = built.trajectory.sample(tsol.solution, s_dense)
+    state_labels = list(sc) + [speed_label(c) for c in sc]
+    out.append(write_table(stage / "Analysis" / f"{trial}_statesInterpolated.sto", dense["time"], state_labels,
+                           dense["states"][:, :2 * len(sc)]))
+    tracked_dense = data.tracked_full_kinematics(s_dense * data.reference_duration)
+    state_idx = [coords.index(c) for c in sc]
+    out.append(write_table(stage / "Analysis" / f"{trial}_trackedInterpolated.sto", dense["time"], state_labels,
+                           np.hstack([tracked_dense[0][:, state_idx], tracked_dense[1][:, state_idx]])))
     out.append(write_moco_trajectory(stage / f"{trial}_mocoTrajectory.sto", t, moco_columns(tsol), name=trial))
     # tracked vs modeled kinematics of the states, on the same times
     ref_t = tsol.view.normalized_time * data.reference_duration

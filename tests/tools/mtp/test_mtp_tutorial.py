@@ -94,7 +94,8 @@ def test_v3_plots(v3, tmp_path):
     assert is_mtp_results(out)
     written = plot_mtp_results(out, tmp_path)
     assert {p.name for p in written} == {"mtp_gait_1_moments.png", "mtp_gait_1_activations.png",
-                                         "mtp_gait_1_fiber_lengths.png", "mtp_passive_moments.png"}
+                                         "mtp_gait_1_fiber_lengths.png", "mtp_passive_moments.png",
+                                         "mtp_parameters.png"}
     assert all(p.stat().st_size > 10_000 for p in written)
 
 

@@ -40,3 +40,39 @@ def test_a_last_iterate_is_titled_as_not_converged(tmp_path: Path, monkeypatch) 
                         lambda self, text, **kw: titles.append(text) or original(self, text, **kw))
     plot_treatment_results(folder)
     assert titles and all("NOT CONVERGED" in t for t in titles), titles
+
+
+def test_compare_figures_through_the_collocation_polynomial(shared_data: Path, tmp_path: Path, capsys) -> None:
+    """TO and DO of the toy arm: the states between the nodes follow each interval's
+    polynomial (equal to the nodes at the interval starts); ``nmsm plot --compare`` draws the
+    TO's figures with the DO overlaid, and the convergence figure from the IPOPT log."""
+    import numpy as np
+
+    from nmsm.io.storage import read_storage
+    from nmsm.plots.treatment import ipopt_iterations
+    from nmsm.tools.treatment.outputs import SAMPLES_PER_POINT
+
+    toy = shared_data / "treatment" / "toy_arm"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run_settings(toy / "tracking_optimization" / "TorqueDrivenTOSettings.xml", results_directory=tmp_path / "to",
+                     print_level=0)
+        run_settings(toy / "design_optimization" / "TorqueDrivenDOSettings.xml", results_directory=tmp_path / "do",
+                     print_level=0)
+    nodes = read_storage(tmp_path / "to" / "arm1_states.sto")
+    dense = read_storage(tmp_path / "to" / "Analysis" / "arm1_statesInterpolated.sto")
+    intervals, points = 5, 10  # the toy arm's mesh
+    per_interval = SAMPLES_PER_POINT * points
+    assert dense.n_rows == intervals * per_interval + 1
+    starts = dense.time[::per_interval]
+    at_starts = [int(np.argmin(np.abs(nodes.time - t))) for t in starts[:-1]]
+    np.testing.assert_allclose(nodes.time[at_starts], starts[:-1], atol=1e-12)
+    np.testing.assert_allclose(dense.data[::per_interval][:-1], nodes.data[at_starts], atol=1e-9)
+    iterations = ipopt_iterations(tmp_path / "to" / "arm1_ipopt.log")
+    assert iterations.shape[0] >= 2 and iterations[0, 0] == 0
+    assert main(["plot", "--compare", str(tmp_path / "to"), str(tmp_path / "do"), "-o", str(tmp_path / "figs")]) == 0
+    assert "to vs" in capsys.readouterr().out
+    names = sorted(p.name for p in (tmp_path / "figs").iterdir())
+    assert names == ["compare_arm1_controls.png", "compare_arm1_convergence.png", "compare_arm1_kinematics.png",
+                     "compare_arm1_loads.png"], names
+    assert main(["plot", "--compare", str(tmp_path / "to")]) == 1  # one folder is nothing to compare
