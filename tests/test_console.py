@@ -16,7 +16,8 @@ TOY = Path("treatment") / "toy_arm"
 def test_start_line_and_summary_print_only_when_switched_on(capsys) -> None:
     line = start_line("TO", settings="/a/b/to.xml", model="/a/leg.osim", trials=[f"t{k}" for k in range(6)],
                       problem="5 mesh intervals")
-    assert line == "nmsm TO: settings to.xml; model leg.osim; trials t0, t1, t2, t3 and 2 more; problem 5 mesh intervals"
+    assert line == ("nmsm TO: settings to.xml; model leg.osim; trials t0, t1, t2, t3 and 2 more; "
+                    "problem 5 mesh intervals")
     announce("TO", settings="to.xml")
     summarize("TO", ["x"])
     assert capsys.readouterr().out == ""  # library calls stay silent
@@ -36,7 +37,8 @@ def test_treatment_run_prints_its_start_line_and_summary(shared_data: Path, tmp_
     summary = out[out.index("nmsm TO summary:"):].splitlines()
     assert re.fullmatch(r"  IPOPT Solve_Succeeded after \d+ iterations, [\d.]+ s; objective \S+ -> \S+", summary[1])
     assert summary[2] == "  tracking RMS (largest term of each group):"
-    assert re.fullmatch(r"    generalized_coordinate_tracking +\S+ deg +\(generalized_coordinate_tracking:r_elbow_flex; "
+    assert re.fullmatch(r"    generalized_coordinate_tracking +\S+ deg +"
+                        r"\(generalized_coordinate_tracking:r_elbow_flex; "
                         r"1 term\(s\)\)", summary[3]), summary[3]
     assert re.fullmatch(r"    inverse_dynamics_load_tracking +\S+ N·m +\(inverse_dynamics_load_tracking:"
                         r"r_elbow_flex_moment; 1 term\(s\)\)", summary[4]), summary[4]

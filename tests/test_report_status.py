@@ -71,7 +71,8 @@ def test_gcp_errors_of_two_feet(tmp_path: Path) -> None:
         "task 1 (2.0 s): ipopt: Solve_Succeeded after 5 iterations, 1.50 s, cost 1\n", encoding="utf-8")
     status = stage_status("gcp", tmp_path)
     assert status.converged is True
-    assert status.headline == "foot 1: force RMS ≤ 3 N, moment RMS ≤ 6 N·m; foot 2: force RMS ≤ 22 N, moment RMS ≤ 25 N·m"
+    assert status.headline == ("foot 1: force RMS ≤ 3 N, moment RMS ≤ 6 N·m; "
+                               "foot 2: force RMS ≤ 22 N, moment RMS ≤ 25 N·m")
 
 
 def test_a_folder_without_summaries_is_unknown(tmp_path: Path) -> None:
