@@ -121,7 +121,7 @@ def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], Non
     if plotter is None or not plotter.matches(folder):
         return []
     try:
-        return sorted(p for p in plotter.draw(folder, scratch) if Path(p).suffix == ".png")
+        return [Path(p) for p in plotter.draw(folder, scratch) if Path(p).suffix == ".png"]  # the plotter's order
     except Exception as exc:  # a figure that cannot be drawn must not lose the rest of the report
         if log:
             log(f"report: no figures for {folder} ({type(exc).__name__}: {exc})")
