@@ -111,14 +111,19 @@ def _reference(ax: Any, axis: Axis, table: Table | None, label: str, factor: flo
         ax.plot(axis.x(table.time), factor * table.column(label), label=name, **style.EXPERIMENTAL)
 
 
+def _speeds_by_coordinate(states: Table) -> Table:
+    """The speed columns (``<coordinate>_u``) of a states table, labelled by coordinate."""
+    speeds = [label for label in states.labels if label.endswith("_u")]
+    return Table(time=states.time, labels=tuple(s.removesuffix("_u") for s in speeds),
+                 data=states.columns(speeds), in_degrees=states.in_degrees)
+
+
 def _kinematics(plt_fig: tuple, axis: Axis, runs: Sequence[Run], trial: str, coords: Sequence[str]) -> None:
     _, _, axes = plt_fig
     dense = runs[0].table(f"Analysis/{trial}_trackedInterpolated.sto")
     tracked = dense or runs[0].table(f"Analysis/{trial}_trackedPositions.sto")
-    tracked_speeds = runs[0].table(f"Analysis/{trial}_trackedVelocities.sto")
-    if dense is not None:
-        tracked_speeds = attrs.evolve(dense, labels=tuple(label.removesuffix("_u") if label.endswith("_u") else
-                                                          f"{label}_position" for label in dense.labels))
+    tracked_speeds = _speeds_by_coordinate(dense) if dense is not None else \
+        runs[0].table(f"Analysis/{trial}_trackedVelocities.sto")
     for j, c in enumerate(coords):
         rot = _rotational(c)
         factor = float(np.degrees(1.0)) if rot else 1.0
