@@ -124,7 +124,8 @@ def load_page(browser: str, page: Path, expression: str, width: int = 1280, heig
                 params = event.get("params", {})
                 if event.get("method") == "Runtime.exceptionThrown":
                     details = params["exceptionDetails"]
-                    errors.append(f"exception: {details.get('exception', {}).get('description') or details.get('text')}")
+                    text = details.get("exception", {}).get("description") or details.get("text")
+                    errors.append(f"exception: {text}")
                 elif event.get("method") == "Log.entryAdded" and params["entry"]["level"] == "error":
                     errors.append(f"log: {params['entry'].get('text')}")
                 elif event.get("method") == "Runtime.consoleAPICalled" and params.get("type") == "error":
