@@ -8,16 +8,24 @@ OpenSim's MuscleAnalysis header: name line, ``version=1``, ``nRows``, ``nColumns
 Poses: the motion's coordinate columns (rotational ones converted from degrees when the
 file says ``inDegrees=yes``), unlisted coordinates at their default values, dependent
 coordinates of couplers from their coupler (what OpenSim's ``Model.assemble`` does).
+As OpenSim's AnalyzeTool sets them (``Coordinate::setValue``), a locked coordinate stays
+at its default value whatever its column says and a clamped coordinate is held within its
+range (:func:`analysis_poses`; both warn, naming the coordinates).
 Coordinate speeds: derivative of an interpolating quintic spline with natural end
 conditions (third and fourth derivatives zero at the ends) through each independent
 coordinate, the spline OpenSim's AnalyzeTool differentiates (GCV spline, error variance
-0); fewer than 6 frames use ``numpy.gradient``. Optional low-pass filtering of the
-coordinates first, as AnalyzeTool's ``lowpass_cutoff_frequency_for_coordinates``.
+0); fewer than 6 frames use ``numpy.gradient``; locked coordinates do not move. Optional
+low-pass filtering of the coordinates first, as AnalyzeTool's
+``lowpass_cutoff_frequency_for_coordinates``.
 
 Quantities (SI): length L (m); velocity ``V = Σ_c dL/dq_c q̇_c`` (m/s) over independent
-coordinates, total derivatives through couplers; moment arm ``r_c = −dL/dq_c`` (m). For a
-dependent (coupled) coordinate the file holds the moment arm of its independent
-coordinate, as OpenSim's ``computeMomentArm`` reports it there.
+coordinates, total derivatives through couplers; moment arm ``r_c = −dL/dq_c`` (m) of
+path-point muscles. For a dependent (coupled) coordinate the file holds the moment arm of
+its independent coordinate, as OpenSim's ``computeMomentArm`` reports it there. Muscles
+computed by OpenSim take OpenSim's ``computeMomentArm`` (what MuscleAnalysis writes): where a
+path wraps over more than one wrap object, or a wrap object limits its path to a quadrant,
+OpenSim's path is not the shortest one, and the moment arm of the forces it applies
+(``computeMomentArm``) is not ``−dL/dq`` of its length.
 
 Engines (how the geometry is computed):
 
@@ -33,6 +41,7 @@ Engines (how the geometry is computed):
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -128,6 +137,44 @@ def motion_poses(model: Any, motion: Table) -> np.ndarray:
     return CoordinateMap(model).dependent_values(q)
 
 
+def analysis_poses(model: Any, q: np.ndarray, *, source: Any = None) -> np.ndarray:
+    """Poses ``(n, n_q)`` as OpenSim's AnalyzeTool sets them from ``q`` ``(n, n_q)``
+    (model order, rad/m): locked coordinates at their default values, clamped coordinates
+    held within their ranges, dependent coordinates recomputed by their couplers. Each
+    change warns once, naming the coordinates, their frames and ``source`` (the motion)."""
+    q = np.array(q, dtype=float)
+    locked, clamped = [], []
+    for i, c in enumerate(model.coordinates):
+        if c.name in model.coupled_coordinates:
+            continue
+        if c.locked:
+            moved = np.abs(q[:, i] - c.default_value) > 1e-12 * max(1.0, abs(c.default_value))
+            if moved.any():
+                locked.append(f"{c.name} ({int(moved.sum())} frames)")
+            q[:, i] = c.default_value
+        elif c.clamped:
+            outside = (q[:, i] < c.range[0]) | (q[:, i] > c.range[1])
+            if outside.any():
+                clamped.append(f"{c.name} ({int(outside.sum())} frames)")
+            q[:, i] = np.clip(q[:, i], c.range[0], c.range[1])
+    where = f"{source}: " if source is not None else ""
+    if locked:
+        warnings.warn(f"{where}locked coordinate(s) {', '.join(_some(locked))} differ from their default value in the "
+                      "motion; they stay at the default, as in OpenSim's MuscleAnalysis", stacklevel=3)
+    if clamped:
+        warnings.warn(f"{where}clamped coordinate(s) {', '.join(_some(clamped))} leave their range in the motion; "
+                      "they are held at the range's limits, as in OpenSim's MuscleAnalysis", stacklevel=3)
+    if model.coupled_coordinates:
+        from nmsm.model.coordinates import CoordinateMap
+
+        q = CoordinateMap(model).dependent_values(q)
+    return q
+
+
+def _some(items: Sequence[str], limit: int = 5) -> list[str]:
+    return list(items[:limit]) + ([f"and {len(items) - limit} more"] if len(items) > limit else [])
+
+
 def coordinate_speeds(time: np.ndarray, q: np.ndarray) -> np.ndarray:
     """``dq/dt`` ``(n, k)`` of ``q`` ``(n, k)`` sampled at ``time`` ``(n,)`` (see module docstring)."""
     from nmsm.model.signal import quintic_spline
@@ -153,8 +200,9 @@ def _filtered(time: np.ndarray, q: np.ndarray, lowpass_hz: float, table: Table) 
 
 # ---- engines ------------------------------------------------------------------------------
 def _opensim_geometry(model_file: Path, model: Any, q: np.ndarray, muscles: Sequence[str], independent: Sequence[str],
-                      bridge: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Lengths ``(n, m)`` and total gradients ``(n, m, len(independent))`` from OpenSim."""
+                      bridge: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lengths ``(n, m)``, total gradients and ``computeMomentArm`` moment arms
+    (``(n, m, len(independent))``) from OpenSim."""
     if bridge is None:
         from nmsm.opensim_bridge import get_bridge
 
@@ -162,8 +210,8 @@ def _opensim_geometry(model_file: Path, model: Any, q: np.ndarray, muscles: Sequ
     # the worker runs in its own working folder: a relative path would not find the model there
     out = bridge.call("muscle_length_gradients", model=str(Path(model_file).resolve()), q=q,
                       coordinates=model.coordinate_names,
-                      muscles=list(muscles), wrt=list(independent))
-    return out["lengths"], out["gradient"]
+                      muscles=list(muscles), wrt=list(independent), moment_arms=True)
+    return out["lengths"], out["gradient"], out["moment_arms"]
 
 
 def _nmsm_geometry(model: Any, q: np.ndarray, muscles: Sequence[str], independent: Sequence[str],
@@ -244,6 +292,8 @@ def analyze_motion(
             q = CoordinateMap(model).dependent_values(q)
     else:
         qdot = coordinate_speeds(table.time, q[:, columns])
+    q = analysis_poses(model, q, source=table.source)
+    qdot[:, [k for k, c in enumerate(independent) if model.coordinate(c).locked]] = 0.0
 
     from nmsm.model.muscle_paths import has_active_wrapping
 
@@ -273,11 +323,13 @@ def analyze_motion(
     if nmsm_cols:
         chosen = [muscles[i] for i in nmsm_cols]
         lengths[:, nmsm_cols], gradient[:, nmsm_cols, :] = _nmsm_geometry(model, q, chosen, independent, surrogate)
+    arms_independent = np.zeros_like(gradient)  # moment arms, (n, m, len(independent))
     osim_cols = [i for i, m in enumerate(muscles) if sources[m] == "opensim"]
     if osim_cols:
         chosen = [muscles[i] for i in osim_cols]
-        lengths[:, osim_cols], gradient[:, osim_cols, :] = _opensim_geometry(model_file, model, q, chosen, independent,
-                                                                            bridge)
+        lengths[:, osim_cols], gradient[:, osim_cols, :], arms_independent[:, osim_cols, :] = _opensim_geometry(
+            model_file, model, q, chosen, independent, bridge)
+    arms_independent[:, nmsm_cols, :] = -gradient[:, nmsm_cols, :]
 
     velocities = np.einsum("nmc,nc->nm", gradient, qdot)
     arms = np.zeros((n, len(muscles), len(coords)))
@@ -285,5 +337,5 @@ def analyze_motion(
         driver = c
         if c in dependents:
             driver = dependents[c].independent[0]
-        arms[:, :, k] = -gradient[:, :, independent.index(driver)]
+        arms[:, :, k] = arms_independent[:, :, independent.index(driver)]
     return MuscleAnalysisResult(table.time.copy(), muscles, coords, lengths, velocities, arms, sources)

@@ -7,7 +7,7 @@ import pytest
 from scipy.interpolate import make_interp_spline
 
 from nmsm.errors import ModelError
-from nmsm.io.storage import read_storage
+from nmsm.io.storage import Table, read_storage
 from nmsm.model import load_model
 from nmsm.model.muscle_analysis import analyze_motion, coordinate_speeds, motion_poses
 from nmsm.model.surrogate import fit_surrogate_model
@@ -37,7 +37,7 @@ def ours(shared_data, bridge):
                           coordinates=SURROGATE_COORDINATES + ["pelvis_tilt", "knee_angle_r_beta"], bridge=bridge)
 
 
-def test_lengths_and_moment_arms_match_opensim_muscle_analysis(ours, opensim_ma, record_property) -> None:
+def test_lengths_and_moment_arms_match_opensim_muscle_analysis(ours, opensim_ma) -> None:
     length = read_storage(opensim_ma / "kick_MuscleAnalysis_Length.sto")
     assert length.labels == ours.muscles
     np.testing.assert_allclose(length.time, ours.time, atol=1e-8)
@@ -45,16 +45,10 @@ def test_lengths_and_moment_arms_match_opensim_muscle_analysis(ours, opensim_ma,
     assert ours.sources == {"bflh_r": "path", "soleus_r": "path", "tibant_r": "path", "bfsh_r": "opensim",
                             "gasmed_r": "opensim", "glmax2_r": "opensim", "iliacus_r": "opensim",
                             "recfem_r": "opensim", "vasmed_r": "opensim"}
-    path = [ours.muscles.index(m) for m in ("bflh_r", "soleus_r", "tibant_r")]
-    worst = 0.0
     for k, coord in enumerate(ours.coordinates):
         arms = read_storage(opensim_ma / f"kick_MuscleAnalysis_MomentArm_{coord}.sto")
-        # exact paths: -dL/dq equals OpenSim's computeMomentArm (no coupler acts on them)
-        assert np.abs(arms.data[:, path] - ours.moment_arms[:, path, k]).max() <= FILE_ROUNDING + 1e-12
-        worst = max(worst, float(np.abs(arms.data - ours.moment_arms[:, :, k]).max()))
-    # wrapping / patella muscles: central differences vs computeMomentArm ("effective" where the coupler acts)
-    record_property("max |computeMomentArm - (-dL/dq)| over all muscles (m)", worst)
-    print(f"OpenSim computeMomentArm vs -dL/dq, all muscles and coordinates: max {worst:.2e} m")
+        # exact paths: -dL/dq; wrapping and patella muscles: OpenSim's computeMomentArm through the bridge
+        assert np.abs(arms.data - ours.moment_arms[:, :, k]).max() <= FILE_ROUNDING + 1e-12, coord
 
 
 def test_dependent_coordinate_reports_its_independent_moment_arm(ours, opensim_ma) -> None:
@@ -151,3 +145,35 @@ def test_lowpass_filtering_matches_opensim(shared_data, bridge, tmp_path) -> Non
     # isolated frames (cause not identified; without filtering every frame agrees to the file's rounding)
     assert np.median(error) <= FILE_ROUNDING and error.max() <= 2e-7
     assert np.abs(ref.data - unfiltered.lengths).max() > 1e-4  # the filter matters for this motion
+
+
+RAJAGOPAL = "jmp/rajagopal_isolated_knee/Rajagopal_4.0_RCNL_markers_scaled.osim"
+GAIT = "preprocessing/uf_subject3_tutorial/PreCompleted/input_data/GaitTrial_IKResults.mot"
+#: gastrocnemii over two wrap cylinders (condyles and shank), and path-point muscles on the left
+#: foot, whose subtalar angle leaves its clamped range in this motion
+WRAP_MUSCLES = ["gasmed_r", "gaslat_r", "gasmed_l", "gaslat_l", "soleus_l", "perlong_l"]
+WRAP_COORDINATES = ["knee_angle_r", "ankle_angle_r", "knee_angle_l", "ankle_angle_l", "subtalar_angle_l"]
+
+
+def test_wrapping_gastrocnemii_match_opensim_muscle_analysis(shared_data, bridge, tmp_path) -> None:
+    """Gait frames 0.10-0.30 s on the Rajagopal model: the condyle wrap of each gastrocnemius
+    engages or lets go in this window (frames 0.10, 0.16 and 0.25 s on the right; 0.04 and
+    0.10 s on the left), and the motion's locked knee_adduction (6.0 deg, default 6.5) and
+    out-of-range subtalar_angle_l are set as OpenSim's AnalyzeTool sets them."""
+    model, motion = shared_data / RAJAGOPAL, shared_data / GAIT
+    bridge.call("run_muscle_analysis", model=str(model), coordinates_file=str(motion),
+                results_directory=str(tmp_path), name="gait", muscles=WRAP_MUSCLES,
+                moment_arm_coordinates=WRAP_COORDINATES, start_time=0.10, end_time=0.30)
+    table = read_storage(motion)
+    window = (table.time >= 0.10 - 1e-9) & (table.time <= 0.30 + 1e-9)
+    cropped = Table(time=table.time[window], labels=table.labels, data=table.data[window],
+                    in_degrees=table.in_degrees, source=table.source)
+    with pytest.warns(UserWarning, match="clamped coordinate.*subtalar_angle_l"):
+        ours = analyze_motion(model, cropped, muscles=WRAP_MUSCLES, coordinates=WRAP_COORDINATES, bridge=bridge)
+    assert ours.sources["gasmed_r"] == "opensim" and ours.sources["perlong_l"] == "path"
+    lengths = read_storage(tmp_path / "gait_MuscleAnalysis_Length.sto")
+    np.testing.assert_allclose(lengths.time, ours.time, atol=1e-8)
+    assert np.abs(lengths.data - ours.lengths).max() <= 1e-6
+    for k, coord in enumerate(WRAP_COORDINATES):
+        arms = read_storage(tmp_path / f"gait_MuscleAnalysis_MomentArm_{coord}.sto")
+        assert np.abs(arms.data - ours.moment_arms[:, :, k]).max() <= 1e-5, coord

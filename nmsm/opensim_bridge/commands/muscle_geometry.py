@@ -302,6 +302,7 @@ def muscle_length_gradients(
     muscles: list[str] | None = None,
     step: float = 1e-5,
     apply_couplers: bool = True,
+    moment_arms: bool = False,
 ) -> dict[str, np.ndarray]:
     """Central differences of OpenSim path lengths.
 
@@ -312,7 +313,11 @@ def muscle_length_gradients(
     alone (partial derivative).
 
     Returns ``lengths`` ``(n_poses, n_muscles)`` (m) and ``gradient``
-    ``(n_poses, n_muscles, n_wrt)`` = dL/dq (m/rad or m/m). Moment arms are ``-gradient``.
+    ``(n_poses, n_muscles, n_wrt)`` = dL/dq (m/rad or m/m). With ``moment_arms`` also
+    ``moment_arms`` ``(n_poses, n_muscles, n_wrt)`` (m): ``Muscle.computeMomentArm`` (what
+    OpenSim's MuscleAnalysis writes) for every coordinate whose gradient is not zero at
+    some pose, zero for the others; it equals ``-gradient`` except where wrapping makes the
+    path other than the shortest (two wrap objects, a quadrant) or a coupler acts.
     """
     osim_model = load_model(model)
     setter = _PoseSetter(osim_model, coordinates, apply_couplers)
@@ -337,7 +342,18 @@ def muscle_length_gradients(
                     qp = setter.couple(qp)
                 side.append(_lengths(chosen, setter.set(qp)))
             grad[i, :, k] = (side[0] - side[1]) / (2.0 * step)
-    return {"lengths": lengths, "gradient": grad}
+    if not moment_arms:
+        return {"lengths": lengths, "gradient": grad}
+    cset = osim_model.getCoordinateSet()
+    coords = [cset.get(c) for c in wrt]
+    spans = np.abs(grad).max(axis=0) > 0.0  # (n_muscles, n_wrt)
+    arms = np.zeros_like(grad)
+    for i, r in enumerate(rows):
+        state = setter.set(setter.full_q(r))
+        for j, m in enumerate(chosen):
+            for k in np.flatnonzero(spans[j]):
+                arms[i, j, k] = m.computeMomentArm(state, coords[k])
+    return {"lengths": lengths, "gradient": grad, "moment_arms": arms}
 
 
 # ---- MuscleAnalysis ------------------------------------------------------------------------
