@@ -5,13 +5,22 @@ coordinate ranges (dependent coordinates through their couplers); inverse dynami
 N) at random (q, qdot, qddot): (a) with every non-muscle force as the ID tool (contact,
 actuators at zero control), (b) with random external loads on two bodies and only gravity.
 
+With ``--muscles``: per model with muscles (identical files once), ``nmsm muscle-analysis``
+against OpenSim's MuscleAnalysis over the tutorial gait trial's 0.10-0.30 s (gastrocnemius
+wraps engage and let go there; coordinates the trial lacks swing within their ranges):
+the worst muscle's moment-arm RMS (m, over frames, worst coordinate) and the worst length
+RMS (m).
+
     python benchmarks/check_models_against_opensim.py [--poses 20] [--states 10]
+    python benchmarks/check_models_against_opensim.py --muscles [--start 0.1 --end 0.3]
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import os
+import tempfile
 import zlib
 from pathlib import Path
 
@@ -29,11 +38,66 @@ def random_poses(model, cm, count, rng):
     return cm.coordinates.dependent_values(lo + (hi - lo) * rng.random((count, len(model.coordinates))))
 
 
+GAIT = "preprocessing/uf_subject3_tutorial/PreCompleted/input_data/GaitTrial_IKResults.mot"
+
+
+def distinct_muscle_models() -> list[Path]:
+    """Shared models with muscles, each distinct file once (first path in sorted order)."""
+    seen, out = set(), []
+    for path in sorted(SHARED.rglob("*.osim")):
+        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        if digest in seen:
+            continue
+        seen.add(digest)
+        if load_model(path).muscles:
+            out.append(path)
+    return out
+
+
+def check_muscles(start: float, end: float) -> None:
+    import attrs
+    import warnings
+
+    from nmsm.io.storage import read_storage
+    from nmsm.model.muscle_analysis_check import compare_with_opensim, gait_motion
+
+    gait = read_storage(SHARED / GAIT)
+    keep = (gait.time >= start - 1e-9) & (gait.time <= end + 1e-9)
+    gait = attrs.evolve(gait, time=gait.time[keep], data=gait.data[keep])
+    bridge = get_bridge()
+    models = distinct_muscle_models()
+    print(f"{len(models)} distinct models with muscles; gait frames {start:g}-{end:g} s ({keep.sum()})")
+    print(f"{'arm RMS mm':>10} {'len RMS mm':>10} {'muscles':>7}  worst muscle (coordinate, source); model")
+    worst_all = (0.0, "", "", "")
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, path in enumerate(models):
+            model = load_model(path)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                result = compare_with_opensim(path, gait_motion(model, gait), Path(tmp) / str(i), bridge=bridge,
+                                              model=model)
+            muscle, rms, coordinate = result.worst()
+            relative = str(path.relative_to(SHARED))
+            print(f"{1e3 * rms:10.4f} {1e3 * result.length_rms.max():10.4f} {len(result.muscles):7d}  {muscle} "
+                  f"({coordinate}, {result.sources[muscle]}); {relative}"
+                  + (f"; not in OpenSim's MuscleAnalysis: {len(result.unreported)}" if result.unreported else ""),
+                  flush=True)
+            if rms > worst_all[0]:
+                worst_all = (rms, muscle, coordinate, relative)
+    print(f"WORST moment-arm RMS {1e3 * worst_all[0]:.4f} mm: {worst_all[1]} ({worst_all[2]}) in {worst_all[3]}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--poses", type=int, default=20)
     parser.add_argument("--states", type=int, default=10)
+    parser.add_argument("--muscles", action="store_true", help="muscle analysis against OpenSim's MuscleAnalysis")
+    parser.add_argument("--start", type=float, default=0.10)
+    parser.add_argument("--end", type=float, default=0.30)
     args = parser.parse_args()
+    if args.muscles:
+        check_muscles(args.start, args.end)
+        return
     bridge = get_bridge()
     files = sorted(SHARED.rglob("*.osim"))
     print(f"{len(files)} models; {args.poses} poses, {args.states} dynamic states each")

@@ -44,6 +44,7 @@ def _markers(args: argparse.Namespace) -> int:
     from nmsm.io.trc import MarkerTable, format_trc
     from nmsm.model import CasadiModel, load_model
     from nmsm.model.id_tool import motion_coordinates
+    from nmsm.model.muscle_analysis import analysis_poses
     from nmsm.core.threads import SOLVER_THREADS
 
     inputs = existing_inputs({args.model: "the input model (MODEL)", args.motion: "the input motion (MOTION)"})
@@ -55,10 +56,9 @@ def _markers(args: argparse.Namespace) -> int:
         rotational = [i for i, c in enumerate(model.coordinates) if c.motion_type == "rotational"]
         values[:, rotational] = np.deg2rad(values[:, rotational])
     cm = CasadiModel(model)
-    dependent = [i for i, name in enumerate(model.coordinate_names) if name in missing and name in model.coupled_coordinates]
-    if dependent:
-        expanded = cm.coordinates.dependent_values(values)
-        values[:, dependent] = expanded[:, dependent]
+    # poses as OpenSim sets them: locked coordinates at their default, clamped ones within range,
+    # dependent ones from their couplers (the markers IK and JMP can reach with this model)
+    values = analysis_poses(model, values, source=args.motion)
     n = motion.n_rows
     positions = np.array(cm.marker_function().map(n, "thread", SOLVER_THREADS)(values.T))  # 3 x (n_markers * n)
     positions = positions.reshape(3, len(model.markers), n, order="F").transpose(2, 1, 0)

@@ -137,6 +137,10 @@ def motion_poses(model: Any, motion: Table) -> np.ndarray:
     return CoordinateMap(model).dependent_values(q)
 
 
+#: a locked coordinate's column counts as moved when it leaves the default by more than this (rad or m)
+POSE_TOLERANCE = 1e-6
+
+
 def analysis_poses(model: Any, q: np.ndarray, *, source: Any = None) -> np.ndarray:
     """Poses ``(n, n_q)`` as OpenSim's AnalyzeTool sets them from ``q`` ``(n, n_q)``
     (model order, rad/m): locked coordinates at their default values, clamped coordinates
@@ -148,7 +152,7 @@ def analysis_poses(model: Any, q: np.ndarray, *, source: Any = None) -> np.ndarr
         if c.name in model.coupled_coordinates:
             continue
         if c.locked:
-            moved = np.abs(q[:, i] - c.default_value) > 1e-12 * max(1.0, abs(c.default_value))
+            moved = np.abs(q[:, i] - c.default_value) > POSE_TOLERANCE
             if moved.any():
                 locked.append(f"{c.name} ({int(moved.sum())} frames)")
             q[:, i] = c.default_value
@@ -160,10 +164,10 @@ def analysis_poses(model: Any, q: np.ndarray, *, source: Any = None) -> np.ndarr
     where = f"{source}: " if source is not None else ""
     if locked:
         warnings.warn(f"{where}locked coordinate(s) {', '.join(_some(locked))} differ from their default value in the "
-                      "motion; they stay at the default, as in OpenSim's MuscleAnalysis", stacklevel=3)
+                      "motion; they stay at the default, as OpenSim's tools set a motion", stacklevel=3)
     if clamped:
         warnings.warn(f"{where}clamped coordinate(s) {', '.join(_some(clamped))} leave their range in the motion; "
-                      "they are held at the range's limits, as in OpenSim's MuscleAnalysis", stacklevel=3)
+                      "they are held at the range's limits, as OpenSim's tools set a motion", stacklevel=3)
     if model.coupled_coordinates:
         from nmsm.model.coordinates import CoordinateMap
 

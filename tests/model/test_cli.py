@@ -51,3 +51,28 @@ def test_markers_command_matches_opensim(shared_data: Path, tmp_path: Path, brid
 def test_errors_are_reported_without_traceback(tmp_path: Path, capsys) -> None:
     assert main(["id", str(tmp_path / "none.osim"), str(tmp_path / "none.mot"), "-o", str(tmp_path / "x.sto")]) == 1
     assert "none.osim: model file not found" in capsys.readouterr().err
+
+
+def test_markers_command_sets_poses_as_opensim(shared_data: Path, tmp_path: Path) -> None:
+    """A motion whose locked coordinate (RCNL2024's pronation, locked at 90 deg) moves: the
+    markers are those of the locked model, which IK and JMP can reach, and a warning says so."""
+    import pytest
+
+    model_path = shared_data / "models" / "RCNL2024.osim"
+    motion_path = shared_data / "preprocessing/uf_subject3_tutorial/PreCompleted/input_data/GaitTrial_IKResults.mot"
+    motion = read_storage(motion_path)
+    data = motion.data.copy()
+    data[:, motion.labels.index("pro_sup_r")] = 60.0  # degrees; the model holds it at 90
+    moved = tmp_path / "moved.mot"
+    from nmsm.io.storage import write_storage
+    import attrs
+
+    write_storage(moved, attrs.evolve(motion, data=data), name="Coordinates")
+    for source, out in ((motion_path, tmp_path / "as_is.trc"), (moved, tmp_path / "moved.trc")):
+        if source == moved:
+            with pytest.warns(UserWarning, match=r"locked coordinate\(s\) mtp_angle_r \(108 frames\), mtp_angle_l \(108 frames\), pro_sup_r \(108 frames\) differ"):
+                assert main(["markers", str(model_path), str(source), "-o", str(out)]) == 0
+        else:
+            assert main(["markers", str(model_path), str(source), "-o", str(out)]) == 0
+    as_is, moved_markers = read_trc(tmp_path / "as_is.trc"), read_trc(tmp_path / "moved.trc")
+    assert np.array_equal(as_is.positions, moved_markers.positions)

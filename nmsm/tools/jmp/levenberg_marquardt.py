@@ -51,6 +51,9 @@ class Jacobian(Protocol):
     def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
         """``s`` with ``(J^T J + mu diag(diag))_ff s_f = -g_f`` and ``s = 0`` off ``free``."""
 
+    def product(self, s: np.ndarray) -> np.ndarray:
+        """``J s`` (m,)."""
+
     def squared_norm_of_product(self, s: np.ndarray) -> float:
         """``|J s|^2``."""
 
@@ -81,8 +84,11 @@ class DenseJacobian:
             step[idx] = -np.linalg.lstsq(a, g[idx], rcond=None)[0]
         return step
 
+    def product(self, s: np.ndarray) -> np.ndarray:
+        return np.asarray(self.matrix @ s).ravel()
+
     def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.matrix @ s
+        v = self.product(s)
         return float(v @ v)
 
 
@@ -108,8 +114,11 @@ class SparseJacobian:
         step[idx] = -scipy.sparse.linalg.splu(a, permc_spec="COLAMD").solve(g[idx])
         return step
 
+    def product(self, s: np.ndarray) -> np.ndarray:
+        return np.asarray(self.matrix @ s).ravel()
+
     def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.matrix @ s
+        v = self.product(s)
         return float(v @ v)
 
 
@@ -166,10 +175,66 @@ class BlockArrowJacobian:
         step_q = -(y + x_b @ step_p)
         return np.concatenate([step_q.ravel(), step_p]) * free
 
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
+    def product(self, s: np.ndarray) -> np.ndarray:
         f, m, n, k = self.shape
         v = np.einsum("fmn,fn->fm", self.dq, s[: f * n].reshape(f, n)) + np.einsum("fmk,k->fm", self.dp, s[f * n:])
-        return float(np.sum(v * v))
+        return v.ravel()
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        v = self.product(s)
+        return float(v @ v)
+
+
+#: damping of the Gauss-Newton step that tests the function tolerance (relative to diag(J^T J))
+GAUSS_NEWTON_DAMPING = 1e-12
+#: largest number of re-solves of one step as variables reach their bounds
+MAX_BOUND_PASSES = 20
+
+
+def bounded_step(jac: Jacobian, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray, x: np.ndarray,
+                 lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The damped step ``s`` (n,) of the linear model restricted to the box.
+
+    Variables whose step would cross a bound are stopped on it, and the step of the others is
+    solved again with those displacements given, minimizing
+    ``|r + J_f s_f + J_b s_b|^2 + mu s_f^T D_f s_f`` over the still free ``f`` (``s_b`` the
+    displacements to the bounds), until no free variable crosses. A step merely clipped to
+    the box is not a minimizer of the model on the box: its predicted decrease is poor, so
+    the damping grows and the iterations crawl while any of the problem's many variables
+    (a coordinate on its range limit in one frame of a JMP trial) presses on a bound.
+    """
+    free = free.copy()
+    pinned = np.zeros_like(x)
+    step = jac.damped_step(g, free, mu, diag)
+    for _ in range(MAX_BOUND_PASSES):
+        trial = x + step
+        crossing = free & ((trial < lower) | (trial > upper))
+        if not crossing.any():
+            break
+        pinned[crossing] = np.clip(trial[crossing], lower[crossing], upper[crossing]) - x[crossing]
+        free &= ~crossing
+        step = jac.damped_step(g + jac.gradient(jac.product(pinned)), free, mu, diag) + pinned
+    return step
+
+
+def _damping_diagonal(jac: Jacobian, free: np.ndarray) -> np.ndarray:
+    """Marquardt's scaling ``diag(J^T J)``, floored at 1e-10 of its largest free entry."""
+    diag = jac.normal_diagonal()
+    return np.maximum(diag, max(float(np.max(diag[free], initial=0.0)), 1e-300) * 1e-10)
+
+
+def _gauss_newton_decrease(jac: Jacobian, r: np.ndarray, x: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                           fixed: np.ndarray) -> float:
+    """Decrease of ``|r|^2`` that the (nearly undamped) Gauss-Newton step within the box
+    predicts from ``x``: how much the linear model says is still to gain. A small accepted
+    decrease means convergence only when this is small too; otherwise the step was small
+    because the damping was large."""
+    g = jac.gradient(r)
+    span = np.maximum(1e-12, 1e-12 * np.abs(x))
+    free = ~(fixed | ((x <= lower + span) & (g > 0)) | ((x >= upper - span) & (g < 0)))
+    diag = _damping_diagonal(jac, free)
+    step = np.clip(x + bounded_step(jac, g, free, GAUSS_NEWTON_DAMPING, diag, x, lower, upper), lower, upper) - x
+    return max(0.0, -(2.0 * float(g @ step) + jac.squared_norm_of_product(step)))
 
 
 #: ``x -> (r (m,), J)``
@@ -238,11 +303,10 @@ def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: An
         if pg_norm <= tol.gtol:
             status, converged = "projected gradient below gtol", True
             break
-        diag = jac.normal_diagonal()
-        diag = np.maximum(diag, max(float(np.max(diag[free], initial=0.0)), 1e-300) * 1e-10)
+        diag = _damping_diagonal(jac, free)
         accepted = exhausted = False
         while True:
-            step = jac.damped_step(g, free, mu, diag)
+            step = bounded_step(jac, g, free, mu, diag, x, lower, upper)
             trial = np.clip(x + step, lower, upper)
             step = trial - x
             if float(np.max(np.abs(step), initial=0.0)) <= tol.xtol * (tol.xtol + float(np.max(np.abs(x), initial=0.0))):
@@ -260,7 +324,8 @@ def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: An
                 previous = cost
                 x, r, jac, cost = trial, r_new, jac_new, cost_new
                 accepted = True
-                if actual <= tol.ftol * previous:
+                if (actual <= tol.ftol * previous
+                        and _gauss_newton_decrease(jac, r, x, lower, upper, fixed) <= tol.ftol * previous):
                     status, converged = "cost change below ftol", True
                 break
             mu *= nu

@@ -85,6 +85,7 @@ class JmpSolution:
     iterations: int
     evaluations: int
     wall_time: float
+    reseated_frames: int = 0
 
 
 class JmpProblem:
@@ -153,6 +154,10 @@ class JmpProblem:
         dq = dq.reshape(m, n, self.n_free).transpose(1, 0, 2)
         dp = dp.reshape(m, n, self.n_parameters).transpose(1, 0, 2)
         return r, BlockArrowJacobian(dq, dp)
+
+    def frame_costs(self, q: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """Sum of squared residuals of each frame ``(F,)`` at coordinates ``q`` ``(F, n_free)``."""
+        return np.asarray(self._costs(q, p, self._x_exp, self._sqrt_w)[0]).sum(axis=0)
 
     def term_costs(self, q: np.ndarray, p: np.ndarray) -> dict[str, float]:
         """Objective contribution of each term (sum over frames)."""

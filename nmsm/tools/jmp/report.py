@@ -101,7 +101,9 @@ def format_task(title: str, rows: Sequence[ErrorRow], variables: Sequence[Design
     lines += ["  (* at a bound)"] if any_at_bound else []
     lines += ["",
               f"Solver: {solver['status']}; {solver['iterations']} iterations, {solver['evaluations']} evaluations, "
-              f"{solver['wall_time']:.2f} s; cost {solver['initial_cost']:.6g} -> {solver['cost']:.6g}"]
+              f"{solver['wall_time']:.2f} s; cost {solver['initial_cost']:.6g} -> {solver['cost']:.6g}"
+              + (f"; {solver['reseated_frames']} frame(s) re-seated in their inverse kinematics"
+                 if solver.get("reseated_frames") else "")]
     lines += [f"Note: {n}" for n in notes]
     return "\n".join(lines) + "\n"
 

@@ -100,7 +100,7 @@ def _task_summary(result: TaskResult, folder: str) -> tuple[str, dict[str, Any]]
     sol = result.solution
     solver = {"status": sol.status, "converged": sol.converged, "iterations": sol.iterations,
               "evaluations": sol.evaluations, "wall_time": sol.wall_time, "initial_cost": sol.initial_cost,
-              "cost": sol.cost}
+              "cost": sol.cost, "reseated_frames": sol.reseated_frames}
     trial = result.trial
     title = (f"{result.label}: {result.task.marker_file_name.name}, {trial.time[0]:g}-{trial.time[-1]:g} s, "
              f"{trial.n_frames} frames, {trial.n_markers} markers")

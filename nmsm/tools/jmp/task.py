@@ -78,6 +78,49 @@ def _warn_small_motion(model_label: str, design: TaskDesign, task: JmpTask, befo
     return notes
 
 
+#: rounds of re-seating frames in a better inverse-kinematics solution (see :func:`solve_reseating_frames`)
+MAX_RESEATS = 5
+#: a frame is re-seated when inverse kinematics lowers its cost by more than this fraction
+RESEAT_GAIN = 1e-3
+
+
+def solve_reseating_frames(problem: JmpProblem, model, trial: MarkerTrial, kinematics: MarkerKinematics,
+                           design: TaskDesign, q0: np.ndarray, p0: np.ndarray, tolerances: Tolerances,
+                           ik_accuracy: float | None) -> JmpSolution:
+    """Solve the task, then re-seat frames whose coordinates sit in a worse local minimum than
+    inverse kinematics finds with the solved parameters, and solve again (at most
+    :data:`MAX_RESEATS` rounds).
+
+    The joint problem moves every frame's coordinates by local steps from their start (the
+    inverse kinematics of the input model): a frame that starts in another basin of its
+    inverse kinematics (a knee at the end of its range, a limb turned the other way) stays
+    there and pulls the parameters with it, while JMP's objective is the marker error left by
+    inverse kinematics of each parameter set. Inverse kinematics with the solved parameters
+    (frame after frame from the first) finds such frames; they restart from its solution.
+    """
+    solution = problem.solve(q0, p0, tolerances)
+    iterations, evaluations, wall = solution.iterations, solution.evaluations, solution.wall_time
+    reseated = 0
+    for _ in range(MAX_RESEATS):
+        ik = inverse_kinematics(model, trial, accuracy=ik_accuracy, kinematics=kinematics,
+                                parameters=design.parameters, parameter_values=solution.p, check_marker_units=False)
+        q_ik = ik.q[:, [ik.coordinate_names.index(n) for n in kinematics.free_names]]
+        current = problem.frame_costs(solution.q, solution.p)
+        better = problem.frame_costs(q_ik, solution.p) < (1.0 - RESEAT_GAIN) * current
+        if not better.any():
+            break
+        q_start = np.where(better[:, None], q_ik, solution.q)
+        reseated += int(better.sum())
+        initial_cost = solution.initial_cost
+        solution = problem.solve(q_start, solution.p, tolerances)
+        iterations += solution.iterations
+        evaluations += solution.evaluations
+        wall += solution.wall_time
+        solution = attrs.evolve(solution, initial_cost=initial_cost, iterations=iterations, evaluations=evaluations,
+                                wall_time=wall, reseated_frames=reseated)
+    return solution
+
+
 def run_task(model_file: Path, task: JmpTask, position: int, *, allowable_error: float, tolerances: Tolerances,
              ik_accuracy: float | None, output: Path, settings_file: str | None = None,
              log: Callable[[str], None] = print) -> TaskResult:
@@ -102,9 +145,11 @@ def run_task(model_file: Path, task: JmpTask, position: int, *, allowable_error:
     q0 = before.q[:, [before.coordinate_names.index(n) for n in kinematics.free_names]]
     term = MarkerDistanceError(max_allowable_error=allowable_error, name=task.name, source=task.source)
     problem = JmpProblem(kinematics, trial, [term], design.lower, design.upper)
-    solution = problem.solve(q0, p0, tolerances)
+    solution = solve_reseating_frames(problem, model, trial, kinematics, design, q0, p0, tolerances, ik_accuracy)
     log(f"{label}: {solution.status} after {solution.iterations} iterations ({solution.wall_time:.1f} s); "
-        f"cost {solution.initial_cost:.6g} -> {solution.cost:.6g}")
+        f"cost {solution.initial_cost:.6g} -> {solution.cost:.6g}"
+        + (f"; {solution.reseated_frames} frame(s) re-seated in their inverse kinematics" if solution.reseated_frames
+           else ""))
     if not solution.converged:
         warnings.warn(f"{settings_file}: {label}: the optimization stopped before converging ({solution.status})",
                       stacklevel=2)

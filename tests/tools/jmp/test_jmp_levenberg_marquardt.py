@@ -76,3 +76,43 @@ def test_evaluation_budget_reported_as_not_converged():
     result = solve(_rosenbrock, np.array([-1.2, 1.0]), tolerances=Tolerances(max_evaluations=3))
     assert not result.converged
     assert result.status == "maximum evaluations reached"
+
+
+def _freudenstein_roth(x: np.ndarray) -> tuple[np.ndarray, DenseJacobian]:
+    r = np.array([-13 + x[0] + ((5 - x[1]) * x[1] - 2) * x[1], -29 + x[0] + ((x[1] + 1) * x[1] - 14) * x[1]])
+    jac = np.array([[1.0, -3 * x[1] ** 2 + 10 * x[1] - 2], [1.0, 3 * x[1] ** 2 + 2 * x[1] - 14]])
+    return r, DenseJacobian(jac)
+
+
+def test_small_damped_decrease_is_not_convergence():
+    """Freudenstein-Roth from (0.5, -2) with a loose function tolerance: after rejected steps
+    the damping is large and an accepted step lowers the cost by less than ftol although
+    Gauss-Newton still predicts more; that must not count as converged (it stopped at
+    (11.46, -0.892) before, 0.05 from the local minimum (11.4128, -0.89681))."""
+    result = solve(_freudenstein_roth, np.array([0.5, -2.0]), tolerances=Tolerances(ftol=1e-3, xtol=1e-12, gtol=1e-12))
+    assert result.converged
+    np.testing.assert_allclose(result.x, [11.41277900, -0.89680525], atol=1e-4)
+    assert result.cost == pytest.approx(48.98425367924, rel=1e-9)
+
+
+def test_step_re_solved_on_reached_bounds_keeps_the_model_decrease():
+    """A variable whose damped step would cross its bound stops on it and the others are
+    solved again: the linear model decreases at least as much as with the step clipped."""
+    from nmsm.tools.jmp.levenberg_marquardt import bounded_step
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        a = rng.normal(size=(12, 6)) @ np.diag([1, 1, 1, 3, 0.3, 2])
+        r = rng.normal(size=12)
+        jac = DenseJacobian(a)
+        x = np.zeros(6)
+        lower, upper = np.full(6, -0.2), np.full(6, 0.2)
+        g, diag = jac.gradient(r), jac.normal_diagonal()
+        free = np.ones(6, dtype=bool)
+
+        def model_decrease(step):
+            return -(2.0 * g @ step + jac.squared_norm_of_product(step))
+
+        clipped = np.clip(jac.damped_step(g, free, 1e-6, diag), lower, upper)
+        bounded = np.clip(bounded_step(jac, g, free, 1e-6, diag, x, lower, upper), lower, upper)
+        assert model_decrease(bounded) >= model_decrease(clipped) - 1e-12
