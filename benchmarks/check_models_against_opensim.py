@@ -54,7 +54,7 @@ def distinct_muscle_models() -> list[Path]:
     return out
 
 
-def check_muscles(start: float, end: float) -> None:
+def check_muscles(start: float, end: float, only: str | None = None) -> None:
     import attrs
     import warnings
 
@@ -65,7 +65,7 @@ def check_muscles(start: float, end: float) -> None:
     keep = (gait.time >= start - 1e-9) & (gait.time <= end + 1e-9)
     gait = attrs.evolve(gait, time=gait.time[keep], data=gait.data[keep])
     bridge = get_bridge()
-    models = distinct_muscle_models()
+    models = [m for m in distinct_muscle_models() if only is None or only in str(m)]
     print(f"{len(models)} distinct models with muscles; gait frames {start:g}-{end:g} s ({keep.sum()})")
     print(f"{'arm RMS mm':>10} {'len RMS mm':>10} {'muscles':>7}  worst muscle (coordinate, source); model")
     worst_all = (0.0, "", "", "")
@@ -78,8 +78,9 @@ def check_muscles(start: float, end: float) -> None:
                                               model=model)
             muscle, rms, coordinate = result.worst()
             relative = str(path.relative_to(SHARED))
-            print(f"{1e3 * rms:10.4f} {1e3 * result.length_rms.max():10.4f} {len(result.muscles):7d}  {muscle} "
-                  f"({coordinate}, {result.sources[muscle]}); {relative}"
+            length = float(result.length_rms.max()) if result.muscles else 0.0
+            print(f"{1e3 * rms:10.4f} {1e3 * length:10.4f} {len(result.muscles):7d}  {muscle or '-'} "
+                  f"({coordinate}, {result.sources.get(muscle, '-')}); {relative}"
                   + (f"; not in OpenSim's MuscleAnalysis: {len(result.unreported)}" if result.unreported else ""),
                   flush=True)
             if rms > worst_all[0]:
@@ -94,9 +95,10 @@ def main() -> None:
     parser.add_argument("--muscles", action="store_true", help="muscle analysis against OpenSim's MuscleAnalysis")
     parser.add_argument("--start", type=float, default=0.10)
     parser.add_argument("--end", type=float, default=0.30)
+    parser.add_argument("--only", help="check only models whose path contains this text")
     args = parser.parse_args()
     if args.muscles:
-        check_muscles(args.start, args.end)
+        check_muscles(args.start, args.end, args.only)
         return
     bridge = get_bridge()
     files = sorted(SHARED.rglob("*.osim"))

@@ -80,7 +80,10 @@ class MuscleAnalysisComparison:
     unreported: tuple[str, ...]
 
     def worst(self) -> tuple[str, float, str]:
-        """(muscle, moment-arm RMS m, coordinate) of the worst muscle."""
+        """(muscle, moment-arm RMS m, coordinate) of the worst muscle (``("", 0.0, "")`` when
+        OpenSim reports none)."""
+        if not self.muscles:
+            return "", 0.0, ""
         k = int(np.argmax(self.moment_arm_rms))
         return self.muscles[k], float(self.moment_arm_rms[k]), self.worst_coordinate[k]
 

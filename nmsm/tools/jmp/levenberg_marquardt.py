@@ -8,14 +8,17 @@ Marquardt's scaled damping ``mu * diag(J^T J)``:
     (J_f^T J_f + mu D_f) s_f = -J_f^T r
 
 over the *free* variables ``f``: a variable sitting on a bound whose gradient pushes it
-outwards is held there for the step (projected active set); every trial point is clipped
-into the box. Damping follows Nielsen's rule (``mu`` shrinks by up to 3x after a good step,
-doubles repeatedly after a rejected one).
+outwards is held there for the step (projected active set); a variable whose step would
+cross its bound stops on it and the step of the others is solved again
+(:func:`bounded_step`). Damping follows Nielsen's rule (``mu`` shrinks by up to 3x after a
+good step, doubles repeatedly after a rejected one).
 
 Convergence (any of):
 
 * ``|step|_inf <= xtol * (xtol + |x|_inf)``                          (step)
-* ``cost - new_cost <= ftol * cost``  for an accepted step           (function)
+* ``cost - new_cost <= ftol * cost``  for an accepted step, and the  (function)
+  decrease the Gauss-Newton step within the box predicts from there is below it too
+  (a heavily damped step decreases little however far the minimum is)
 * ``|projected J^T r|_inf <= gtol``                                 (first order)
 * ``cost <= ctol``                                                   (exact fit)
 
