@@ -79,13 +79,13 @@ def check_muscles(start: float, end: float, only: str | None = None) -> None:
             muscle, rms, coordinate = result.worst()
             relative = str(path.relative_to(SHARED))
             length = float(result.length_rms.max()) if result.muscles else 0.0
-            print(f"{1e3 * rms:10.4f} {1e3 * length:10.4f} {len(result.muscles):7d}  {muscle or '-'} "
+            print(f"{1e3 * rms:10.2e} {1e3 * length:10.2e} {len(result.muscles):7d}  {muscle or '-'} "
                   f"({coordinate}, {result.sources.get(muscle, '-')}); {relative}"
                   + (f"; not in OpenSim's MuscleAnalysis: {len(result.unreported)}" if result.unreported else ""),
                   flush=True)
             if rms > worst_all[0]:
                 worst_all = (rms, muscle, coordinate, relative)
-    print(f"WORST moment-arm RMS {1e3 * worst_all[0]:.4f} mm: {worst_all[1]} ({worst_all[2]}) in {worst_all[3]}")
+    print(f"WORST moment-arm RMS {1e3 * worst_all[0]:.2e} mm: {worst_all[1]} ({worst_all[2]}) in {worst_all[3]}")
 
 
 def main() -> None:
