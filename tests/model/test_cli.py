@@ -70,7 +70,9 @@ def test_markers_command_sets_poses_as_opensim(shared_data: Path, tmp_path: Path
     write_storage(moved, attrs.evolve(motion, data=data), name="Coordinates")
     for source, out in ((motion_path, tmp_path / "as_is.trc"), (moved, tmp_path / "moved.trc")):
         if source == moved:
-            with pytest.warns(UserWarning, match=r"locked coordinate\(s\) mtp_angle_r \(108 frames\), mtp_angle_l \(108 frames\), pro_sup_r \(108 frames\) differ"):
+            expected = (r"locked coordinate\(s\) mtp_angle_r \(108 frames\), mtp_angle_l \(108 frames\), "
+                        r"pro_sup_r \(108 frames\) differ")
+            with pytest.warns(UserWarning, match=expected):
                 assert main(["markers", str(model_path), str(source), "-o", str(out)]) == 0
         else:
             assert main(["markers", str(model_path), str(source), "-o", str(out)]) == 0

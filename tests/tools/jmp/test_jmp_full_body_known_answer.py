@@ -64,7 +64,8 @@ def test_knees_of_full_body_model_are_recovered_exactly(shared_data, tmp_path):
                            name="Coordinates")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the motion's locked mtp angles (tests/model/test_cli.py)
-        assert main(["markers", str(true_model), str(motion), "--units", "mm", "-o", str(tmp_path / "markers.trc")]) == 0
+        markers = tmp_path / "markers.trc"
+        assert main(["markers", str(true_model), str(motion), "--units", "mm", "-o", str(markers)]) == 0
     model = load_model(true_model)
     writer = OsimWriter(true_model)
     truth = {}
