@@ -37,6 +37,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "nmsm.tools.ncp.cli",  # vaf
     "nmsm.plots.cli",  # plot
     "nmsm.tools.pipeline.cli",  # pipeline, example, report, export
+    "nmsm.batch.cli",  # batch
 )
 
 

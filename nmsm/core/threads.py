@@ -7,11 +7,23 @@ from collections.abc import Collection
 
 import casadi as cs
 
+#: environment variable that sets :data:`SOLVER_THREADS` (a whole number >= 1): ``nmsm batch``
+#: starts its worker processes with 1, so that runs in parallel do not share cores
+THREADS_VARIABLE = "NMSM_THREADS"
+
+
+def _threads() -> int:
+    text = os.environ.get(THREADS_VARIABLE, "").strip()
+    if text.isdigit() and int(text) >= 1:
+        return int(text)
+    return min(2, os.cpu_count() or 1)
+
+
 #: threads of parallel CasADi evaluations (``map`` with ``thread`` parallelization): two
-#: where the machine has two or more cores. Measured on the 2-core CI machine
-#: (docs/mtp.md, docs/treatment.md); MUMPS's BLAS threads share the same cores, so more
-#: is not used without a measurement.
-SOLVER_THREADS = min(2, os.cpu_count() or 1)
+#: where the machine has two or more cores, unless :data:`THREADS_VARIABLE` says otherwise.
+#: Measured on the 2-core CI machine (docs/mtp.md, docs/treatment.md); MUMPS's BLAS threads
+#: share the same cores, so more is not used without a measurement.
+SOLVER_THREADS = _threads()
 
 
 def thread_map(function: cs.Function, n: int, *, shared: Collection[int] = (), threads: int = SOLVER_THREADS,

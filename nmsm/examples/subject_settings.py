@@ -294,8 +294,19 @@ def _initial_state() -> str:
             + _constraint("initial_generalized_speed_deviation", -1e-2, 1e-2, coordinate_list=coordinates))
 
 
-def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -> str:
-    """``to``, ``vo`` or ``do`` settings of the example (synergy-driven, foot springs from GCP)."""
+def _synergy_scale_term(n_synergies: int, scale: float) -> str:
+    """A DO parameter term fixing the scale of every synergy's activation at ``scale``."""
+    synergies = " ".join(f"{sm.SYNERGY_GROUP}_{k}" for k in range(1, n_synergies + 1))
+    return (f"""<RCNLParameterTerm><type>synergy_activation_scale</type>
+          <synergy_list>{synergies}</synergy_list>
+          <initial_values>{scale:g}</initial_values><lower_bounds>{scale:g}</lower_bounds>
+          <upper_bounds>{scale:g}</upper_bounds></RCNLParameterTerm>""")
+
+
+def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int, *,
+                  synergy_scale: float | None = None) -> str:
+    """``to``, ``vo`` or ``do`` settings of the example (synergy-driven, foot springs from GCP).
+    ``synergy_scale``: the DO also scales every synergy's activation by this (fixed) value."""
     coordinates = " ".join(sm.MUSCLE_COORDINATES)
     loads = " ".join(f"{c}_moment" for c in sm.MUSCLE_COORDINATES)
     muscles = " ".join(sm.MUSCLES)
@@ -323,14 +334,16 @@ def treatment_xml(kind: str, subject: Subject, folder: Path, n_synergies: int) -
     common = _treatment_common(subject, folder, "do", "results/vo", "results/vo", solver="solver_do.xml")
     strength = PLANTARFLEXOR_STRENGTH
     costs = _term("controller_tracking", 1.0, controller_list=synergies)  # as VO: only the strength differs
+    functions = "scaleMaxIsometricForce" + (" scaleSynergyActivations" if synergy_scale is not None else "")
+    scale = "" if synergy_scale is None else _synergy_scale_term(n_synergies, synergy_scale)
     return f"""<DesignOptimizationTool>
         {common}
         {_synergy_controller(False)}
-        <model_functions>scaleMaxIsometricForce</model_functions>
+        <model_functions>{functions}</model_functions>
         <RCNLParameterTermSet><RCNLParameterTerm><type>max_isometric_force_scale</type>
           <muscle_list>{" ".join(PLANTARFLEXORS)}</muscle_list>
           <initial_values>{strength:g}</initial_values><lower_bounds>{strength:g}</lower_bounds>
-          <upper_bounds>{strength:g}</upper_bounds></RCNLParameterTerm></RCNLParameterTermSet>
+          <upper_bounds>{strength:g}</upper_bounds></RCNLParameterTerm>{scale}</RCNLParameterTermSet>
         <RCNLCostTermSet>{costs}</RCNLCostTermSet>
         <RCNLConstraintTermSet>{_consistency()}{_initial_state()}</RCNLConstraintTermSet>
       </DesignOptimizationTool>"""

@@ -17,13 +17,25 @@ from nmsm.io.settings.document import TOOL_ELEMENTS
 
 #: ``print-xml`` tool codes -> tool element
 TOOL_CODES = {code: element for element, code in TOOL_ELEMENTS.items()}
+#: ``print-xml`` codes of files that are not a tool's settings -> "module:template text"
+OTHER_TEMPLATES = {"batch": "nmsm.batch.template:BATCH_TEMPLATE"}
+
+
+def _template(code: str) -> str:
+    import importlib
+
+    from nmsm.io.settings.template import format_template
+
+    if code in OTHER_TEMPLATES:
+        module, _, name = OTHER_TEMPLATES[code].partition(":")
+        return str(getattr(importlib.import_module(module), name))
+    return format_template(TOOL_CODES[code])
 
 
 def _print_xml(args: argparse.Namespace) -> int:
     from nmsm.io.output_file import check_output, write_output
-    from nmsm.io.settings.template import format_template
 
-    text = format_template(TOOL_CODES[args.tool])
+    text = _template(args.tool)
     if args.output:
         path = check_output(args.output, force=args.force, example_name=f"{args.tool}.xml")
         replaced = path.exists()
@@ -54,7 +66,8 @@ def register(subparsers: Any) -> None:
         "print-xml",
         help="write a commented settings template of a tool (defaults and descriptions)",
     )
-    p.add_argument("tool", choices=list(TOOL_CODES), help="jmp, mtp, ncp, gcp, to, vo, do or solver")
+    p.add_argument("tool", choices=[*TOOL_CODES, *OTHER_TEMPLATES],
+                   help="jmp, mtp, ncp, gcp, to, vo, do, solver, or batch (a batch file of nmsm batch)")
     p.add_argument("-o", "--output", help="file to write (default: standard output); its folder must exist")
     p.add_argument("--force", action="store_true", help="replace the -o file if it exists")
     p.set_defaults(func=_print_xml)
