@@ -88,7 +88,8 @@ class BatchRun:
 
 def input_digest(plan: RunPlan, cache: Any) -> str | None:
     """Digest of a settings run's inputs (settings with every path replaced by the digest of
-    what it names, nmsm's code); None for a pipeline run (its runner keeps it up to date)."""
+    what it names, nmsm's code); None for a pipeline run (its runner keeps its stages up to
+    date: :func:`_pipeline_up_to_date`)."""
     from nmsm.tools.pipeline.hashing import code_digest
 
     if plan.kind != "settings":
@@ -97,13 +98,32 @@ def input_digest(plan: RunPlan, cache: Any) -> str | None:
     return settings.input_digest(cache, kind.code, DIGEST_VERSION, code_digest())
 
 
+def _pipeline_up_to_date(plan: RunPlan) -> bool:
+    """Whether the pipeline runner finds every stage of a pipeline run up to date (checked
+    without running anything; any problem: not up to date, the run reports it)."""
+    from nmsm.tools.pipeline.pipeline_file import read_pipeline
+    from nmsm.tools.pipeline.runner import DISABLED, UP_TO_DATE, run_pipeline
+
+    if not (plan.folder / "pipeline_state.json").is_file():
+        return False
+    try:
+        spec = attrs.evolve(read_pipeline(plan.source), results_directory=plan.folder)
+        check = run_pipeline(spec, check_only=True, log=None)
+    except Exception:  # noqa: BLE001 - the run itself reports what is wrong
+        return False
+    return all(stage.status in (UP_TO_DATE, DISABLED) for stage in check.stages)
+
+
 def _finished_earlier(plan: RunPlan, digest: str | None, cache: Any) -> RunOutcome | None:
     """The recorded outcome (status ``skipped``) when the run finished with these inputs and its
-    results are unchanged, else None."""
+    results are unchanged (a pipeline run: its runner finds every stage up to date), else None."""
     record = read_record(plan)
-    if digest is None or record is None or record.get("input_digest") != digest or not plan.folder.is_dir():
+    if record is None or not plan.folder.is_dir():
         return None
-    if cache.folder(plan.folder) != record.get("output_digest"):
+    if plan.kind == "pipeline":
+        if not _pipeline_up_to_date(plan):
+            return None
+    elif record.get("input_digest") != digest or cache.folder(plan.folder) != record.get("output_digest"):
         return None
     outcome = RunOutcome.from_json(record.get("outcome", {"name": plan.name, "status": SKIPPED}))
     return attrs.evolve(outcome, status=SKIPPED, message=f"finished {record.get('finished', 'earlier')} with the "

@@ -215,6 +215,5 @@ def check_runs(spec: BatchSpec, plans: list[RunPlan]) -> dict[str, str]:
                 varied = ", ".join(f"{n} = '{v}'" for n, v in plan.varied)
                 line = _parameter_of(entries[plan.entry], plan.varied[0][0]).line
                 raise spec.error(f"sweep '{entry.name}', variant '{plan.variant}' ({varied}): its settings do not "
-                                 f"read: {exc}", line=line, element="<values>",
-                                 expected="values the tool reads for these elements") from None
+                                 f"read: {exc}", line=line, element="<values>") from None
     return broken

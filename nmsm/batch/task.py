@@ -12,7 +12,8 @@ The batch keeps its own records in ``<results>/.nmsm-batch/``:
   it fails or is stopped (a failure that wrote a last iterate keeps that, and the earlier
   results go into its ``superseded/``), removed once it finished;
 * ``<run>.json`` once it finished: the digest of its inputs (:func:`nmsm.batch.execute.input_digest`),
-  the digest of its results folder and its outcome, so a rerun with the same inputs skips it.
+  the digest of its results folder and its outcome, so a rerun with the same inputs skips it
+  (a pipeline run is skipped when its runner finds every stage up to date).
 
 A worker that dies mid-run leaves the attempt record: the next attempt (the scheduler
 retries the run on another worker, or a later ``nmsm batch``) removes what the dead one
@@ -195,7 +196,7 @@ def _all_up_to_date(result: Any) -> bool:
 
 def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
     """Run ``plan`` (module docstring); ``digest``: its input digest, recorded when it
-    finishes (None: a pipeline run, which the pipeline runner keeps up to date). A failure
+    finishes (None: a pipeline run, whose runner keeps its stages up to date). A failure
     is the outcome's message; Ctrl-C (KeyboardInterrupt) and a dying process are not caught."""
     from nmsm.tools.pipeline.hashing import DigestCache
 
@@ -234,10 +235,9 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
     status = SKIPPED if plan.kind == "pipeline" and _all_up_to_date(result) else OK
     outcome = RunOutcome(plan.name, status, wall_time=time.perf_counter() - began, worker=address,
                          attempts=attempts, warnings=tuple(caught), **headline(result, plan.folder))
-    if digest is not None:
-        _write_json(record_path(plan), {"run": plan.name, "input_digest": digest,
-                                        "output_digest": DigestCache().folder(plan.folder),
-                                        "finished": datetime.datetime.now().isoformat(timespec="seconds"),
-                                        "outcome": outcome.to_json()})
+    _write_json(record_path(plan), {"run": plan.name, "input_digest": digest,
+                                    "output_digest": DigestCache().folder(plan.folder),
+                                    "finished": datetime.datetime.now().isoformat(timespec="seconds"),
+                                    "outcome": outcome.to_json()})
     admin_path(plan, ".attempt.json").unlink(missing_ok=True)
     return outcome

@@ -4,6 +4,7 @@
 
     nmsm pipeline PIPELINE.xml [--until STAGE] [--only STAGE ...] [--force STAGE ...] [--rebuild] [--check]
     nmsm example [STAGE] [--folder DIR]            # the built-in synthetic subject, lab data to treatment
+    nmsm example --batch [--workers N]             # its DO swept on Dask (nmsm.examples.batch_example)
     nmsm report RESULTS_DIR [-o report.html]       # one HTML page with every stage's tables and plots
     nmsm export OSIMX -o MODEL.osim [--model M.osim] [--no-contact]
                 [--treatment RESULTS_DIR --loads LOADS.xml]   # ExternalLoads of a treatment solution

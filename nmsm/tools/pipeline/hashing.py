@@ -97,8 +97,9 @@ def _visible_files(root: Path, exclude: set[Path]) -> Iterable[tuple[str, Path]]
 
 
 _CODE_DIGEST: str | None = None
-#: packages of nmsm that cannot change a stage's results (examples write settings, which are hashed)
-_NOT_RESULTS = ("examples", "report", "plots")
+#: packages of nmsm that cannot change a stage's results (examples write settings, which are hashed;
+#: the batch hands settings files to the tools)
+_NOT_RESULTS = ("examples", "report", "plots", "batch")
 
 
 def code_digest() -> str:
