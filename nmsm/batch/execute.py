@@ -118,7 +118,7 @@ def _finished_earlier(plan: RunPlan, digest: str | None, cache: Any) -> RunOutco
     """The recorded outcome (status ``skipped``) when the run finished with these inputs and its
     results are unchanged (a pipeline run: its runner finds every stage up to date), else None."""
     record = read_record(plan)
-    if record is None or not plan.folder.is_dir():
+    if record is None or not plan.folder.is_dir() or record.get("outcome", {}).get("status") not in FINISHED:
         return None
     if plan.kind == "pipeline":
         if not _pipeline_up_to_date(plan):

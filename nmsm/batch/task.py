@@ -13,7 +13,8 @@ The batch keeps its own records in ``<results>/.nmsm-batch/``:
   results go into its ``superseded/``), removed once it finished;
 * ``<run>.json`` once it finished: the digest of its inputs (:func:`nmsm.batch.execute.input_digest`),
   the digest of its results folder and its outcome, so a rerun with the same inputs skips it
-  (a pipeline run is skipped when its runner finds every stage up to date).
+  (a pipeline run is skipped when its runner finds every stage up to date); once it failed,
+  its outcome (never skipped).
 
 A worker that dies mid-run leaves the attempt record: the next attempt (the scheduler
 retries the run on another worker, or a later ``nmsm batch``) removes what the dead one
@@ -36,6 +37,7 @@ import numpy as np
 
 from nmsm.batch.outcome import FAILED, OK, SKIPPED, RunOutcome
 from nmsm.batch.sweep import RunPlan
+from nmsm.errors import NmsmError
 
 ADMIN = ".nmsm-batch"
 #: Dask event topic of the "run started" messages (:func:`run_one`)
@@ -220,12 +222,14 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
                 caught = list(dict.fromkeys(str(w.message) for w in seen))[:KEPT_WARNINGS]
     except Exception as exc:  # noqa: BLE001 - one failing run is its outcome, the batch goes on
         _after_failure(plan, earlier, exc)
+        message = str(exc) if isinstance(exc, NmsmError) else f"{type(exc).__name__}: {exc}"
+        outcome = RunOutcome(plan.name, FAILED, message=message, wall_time=time.perf_counter() - began,
+                             worker=address, attempts=attempts, warnings=tuple(caught))
+        _write_json(record_path(plan), {"run": plan.name, "input_digest": None,
+                                        "finished": datetime.datetime.now().isoformat(timespec="seconds"),
+                                        "outcome": outcome.to_json()})
         admin_path(plan, ".attempt.json").unlink(missing_ok=True)
-        message = str(exc) if str(exc) else type(exc).__name__
-        if not isinstance(exc, (OSError, ValueError)) and "Error" not in message[:40]:
-            message = f"{type(exc).__name__}: {message}"
-        return RunOutcome(plan.name, FAILED, message=message, wall_time=time.perf_counter() - began,
-                          worker=address, attempts=attempts, warnings=tuple(caught))
+        return outcome
     except BaseException as exc:  # Ctrl-C: nothing of this attempt stays
         _after_failure(plan, earlier, exc)
         admin_path(plan, ".attempt.json").unlink(missing_ok=True)
