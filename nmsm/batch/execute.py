@@ -29,6 +29,7 @@ import queue
 import shutil
 import time
 import uuid
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -107,8 +108,10 @@ def _pipeline_up_to_date(plan: RunPlan) -> bool:
     if not (plan.folder / "pipeline_state.json").is_file():
         return False
     try:
-        spec = attrs.evolve(read_pipeline(plan.source), results_directory=plan.folder)
-        check = run_pipeline(spec, check_only=True, log=None)
+        with warnings.catch_warnings():  # the run repeats them when it runs
+            warnings.simplefilter("ignore")
+            spec = attrs.evolve(read_pipeline(plan.source), results_directory=plan.folder)
+            check = run_pipeline(spec, check_only=True, log=None)
     except Exception:  # noqa: BLE001 - the run itself reports what is wrong
         return False
     return all(stage.status in (UP_TO_DATE, DISABLED) for stage in check.stages)
@@ -148,8 +151,7 @@ def _check_folders(spec: BatchSpec, plans: list[RunPlan]) -> None:
 
 
 @contextlib.contextmanager
-def connect(workers: int | None, scheduler: str | None, timeout: float,
-            log: Callable[[str], None]) -> Iterator[tuple[Any, int, str | None, bool]]:
+def connect(workers: int | None, scheduler: str | None, timeout: float) -> Iterator[tuple[Any, int, str | None, bool]]:
     """``(client, number of workers, dashboard address or None, local)`` (module docstring, step 2)."""
     from distributed import Client, LocalCluster
 
@@ -244,7 +246,7 @@ class _Cluster:
     def get(self) -> Any:
         if self.client is None:
             client, self.count, self.dashboard, _ = self.stack.enter_context(
-                connect(self.workers, self.scheduler, self.timeout, self.say))
+                connect(self.workers, self.scheduler, self.timeout))
             client.subscribe_topic(EVENT_TOPIC, lambda event: self.events.put(event[1]))
             self.say(f"{self.count} Dask worker(s)" + (f"; dashboard {self.dashboard}" if self.dashboard else ""))
             self.client = client
@@ -327,6 +329,9 @@ def run_batch(batch_file: str | os.PathLike[str], *, results_directory: str | os
     say = log or (lambda text: None)
     if workers is not None and workers < 1:
         raise InputError(f"{workers} workers", element="--workers", expected="a whole number >= 1")
+    if workers is not None and scheduler:
+        raise InputError("--workers sets the size of the local cluster; with --scheduler the cluster's own workers "
+                         "run the batch", element="--workers", expected="--workers or --scheduler, not both")
     spec = read_batch(batch_file, results_directory)
     plans = link(spec, expand(spec))
     broken = check_runs(spec, plans)

@@ -38,9 +38,10 @@ def test_an_element_path_the_settings_do_not_have(jmp_case, tmp_path) -> None:
 
 
 def test_a_path_matching_several_elements_is_refused(jmp_case, tmp_path) -> None:
+    both_joints = "JMPTaskList/JMPTask/JMPJointSet/JMPJoint/parent_frame_transformation/orientation_bounds"
     batch = write_batch(tmp_path, f"""\
         <Sweep name="s"><settings_file>{jmp_case.settings_file}</settings_file>
-          <Parameter name="p"><element>JMPTaskList/JMPTask/JMPJointSet/JMPJoint/parent_frame_transformation/orientation_bounds</element><values>1</values></Parameter>
+          <Parameter name="p"><element>{both_joints}</element><values>1</values></Parameter>
         </Sweep>""")
     _refused(batch, "matches 2 elements", "[@name='...']")
 
@@ -97,6 +98,7 @@ def test_a_scheduler_that_does_not_answer(jmp_case, tmp_path) -> None:
     batch = write_batch(tmp_path, f'<Run name="a"><settings_file>{jmp_case.settings_file}</settings_file></Run>')
     _refused(batch, "the scheduler at tcp://127.0.0.1:9 did not answer within 1 s", scheduler="tcp://127.0.0.1:9",
              timeout=1.0)
+    _refused(batch, "--workers or --scheduler, not both", scheduler="tcp://127.0.0.1:9", workers=2)
 
 
 def test_the_printed_batch_file_reads(tmp_path, capsys) -> None:
@@ -109,3 +111,14 @@ def test_the_printed_batch_file_reads(tmp_path, capsys) -> None:
     assert [(e.name, e.kind, e.is_sweep) for e in spec.entries] == [("P01", "pipeline", False),
                                                                     ("P01_weakness", "settings", True)]
     assert [p.name for p in spec.entries[1].parameters] == ["strength", "tracking_error"]
+
+
+def test_the_command_reports_bad_input_in_one_line(jmp_case, tmp_path, capsys) -> None:
+    settings = jmp_case.settings_file
+    batch = write_batch(tmp_path, f"""\
+        <Run name="a"><settings_file>{settings}</settings_file><depends_on>b</depends_on></Run>
+        <Run name="b"><settings_file>{settings}</settings_file><depends_on>a</depends_on></Run>""")
+    assert main(["batch", str(batch), "--workers", "2"]) == 1
+    error = capsys.readouterr().err.strip()
+    assert error.startswith(f"nmsm: error: {batch}: <depends_on>: a dependency cycle: a -> b -> a"), error
+    assert "\n" not in error and not (tmp_path / "out").exists()
