@@ -8,9 +8,11 @@ its pipeline file with the pipeline runner into ``<results>/<run>/``
 The batch keeps its own records in ``<results>/.nmsm-batch/``:
 
 * ``<run>.attempt.json`` while the run runs (worker, process id, start time);
-* ``<run>.earlier/``: a settings run's earlier results while it runs again, put back if
-  it fails or is stopped (a failure that wrote a last iterate keeps that, and the earlier
-  results go into its ``superseded/``), removed once it finished;
+* ``<run>.earlier/``: a settings run's earlier results, settings copy and record while it
+  runs again; put back if it is stopped; if it fails, the earlier results and record are put
+  back (the failed attempt's settings copy stays: the message may name it), or, when the
+  failure wrote a last iterate, that stays and the earlier results go into its
+  ``superseded/``; removed once it finished;
 * ``<run>.json`` once it finished: the digest of its inputs (:func:`nmsm.batch.execute.input_digest`),
   the digest of its results folder and its outcome, so a rerun with the same inputs skips it
   (a pipeline run is skipped when its runner finds every stage up to date); once it failed,
@@ -75,17 +77,38 @@ def _write_json(path: Path, data: dict[str, Any]) -> None:
     write_output(path, json.dumps(data, indent=1) + "\n")
 
 
+def _parts(plan: RunPlan) -> tuple[tuple[Path, str], ...]:
+    """What a settings run's earlier state is made of, and its name in the aside folder."""
+    return ((plan.folder, "results"), (plan.settings_copy, "settings.xml"), (record_path(plan), "record.json"))
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink(missing_ok=True)
+
+
+def _put_back(plan: RunPlan, names: tuple[str, ...] = ("results", "settings.xml", "record.json")) -> None:
+    """Remove what the current attempt wrote of ``names`` and move the earlier ones back from
+    the aside folder (removed afterwards)."""
+    aside = admin_path(plan, ".earlier")
+    for path, name in _parts(plan):
+        if name in names:
+            _remove(path)
+            if (aside / name).exists():
+                path.parent.mkdir(parents=True, exist_ok=True)
+                (aside / name).rename(path)
+    if aside.exists():
+        shutil.rmtree(aside)
+
+
 def recover(plan: RunPlan) -> bool:
     """Undo what an interrupted attempt left (module docstring); whether there was one."""
-    attempt, earlier = admin_path(plan, ".attempt.json"), admin_path(plan, ".earlier")
+    attempt = admin_path(plan, ".attempt.json")
     interrupted = attempt.exists()
-    if earlier.exists():
-        if plan.folder.exists():
-            shutil.rmtree(plan.folder)
-        plan.folder.parent.mkdir(parents=True, exist_ok=True)
-        earlier.rename(plan.folder)
-    elif interrupted and plan.kind == "settings" and plan.folder.exists():
-        shutil.rmtree(plan.folder)
+    if plan.kind == "settings" and (interrupted or admin_path(plan, ".earlier").exists()):
+        _put_back(plan)
     attempt.unlink(missing_ok=True)
     return interrupted
 
@@ -164,30 +187,36 @@ def _run_pipeline(plan: RunPlan) -> Any:
     return run_pipeline(spec, log=None)
 
 
-def _set_aside(plan: RunPlan) -> Path | None:
-    if plan.kind != "settings" or not plan.folder.exists():
-        return None
-    earlier = admin_path(plan, ".earlier")
-    earlier.parent.mkdir(parents=True, exist_ok=True)
-    plan.folder.rename(earlier)
-    return earlier
-
-
-def _after_failure(plan: RunPlan, earlier: Path | None, exc: BaseException) -> None:
-    """Put the earlier results back, or keep a last iterate and file the earlier results in
-    its ``superseded/`` (module docstring)."""
+def _set_aside(plan: RunPlan) -> None:
+    """Move a settings run's earlier results, settings copy and record into the aside folder."""
     if plan.kind != "settings":
+        record_path(plan).unlink(missing_ok=True)
         return
+    aside = admin_path(plan, ".earlier")
+    aside.mkdir(parents=True)
+    for path, name in _parts(plan):
+        if path.exists():
+            path.rename(aside / name)
+
+
+def _after_failure(plan: RunPlan, exc: BaseException) -> bool:
+    """After a failed attempt: keep a last iterate (its folder and settings copy; the earlier
+    results go into its ``superseded/``), or remove the partial results and put the earlier
+    results and record back (the attempt's settings copy stays: the message may name it).
+    Returns whether an earlier record is back."""
+    if plan.kind != "settings":
+        return False
+    aside = admin_path(plan, ".earlier")
     if getattr(exc, "last_iterate_path", None) is not None and plan.folder.exists():
-        if earlier is not None:
+        if (aside / "results").exists():
             target = plan.folder / "superseded" / "earlier_batch_run"
             target.parent.mkdir(parents=True, exist_ok=True)
-            earlier.rename(target)
-        return
-    if plan.folder.exists():
-        shutil.rmtree(plan.folder)
-    if earlier is not None:
-        earlier.rename(plan.folder)
+            (aside / "results").rename(target)
+        shutil.rmtree(aside, ignore_errors=True)
+        return False
+    had_record = (aside / "record.json").exists()
+    _put_back(plan, ("results", "record.json"))
+    return had_record
 
 
 def _all_up_to_date(result: Any) -> bool:
@@ -207,11 +236,10 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
     if worker is not None:
         worker.log_event(EVENT_TOPIC, {"run": plan.name, "pid": os.getpid(), "worker": address})
     attempts = 2 if recover(plan) else 1
-    record_path(plan).unlink(missing_ok=True)
+    _set_aside(plan)
     _write_json(admin_path(plan, ".attempt.json"), {
         "run": plan.name, "worker": address, "pid": os.getpid(),
         "started": datetime.datetime.now().isoformat(timespec="seconds")})
-    earlier = _set_aside(plan)
     caught: list[str] = []
     try:
         with warnings.catch_warnings(record=True) as seen:
@@ -221,21 +249,19 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
             finally:
                 caught = list(dict.fromkeys(str(w.message) for w in seen))[:KEPT_WARNINGS]
     except Exception as exc:  # noqa: BLE001 - one failing run is its outcome, the batch goes on
-        _after_failure(plan, earlier, exc)
         message = str(exc) if isinstance(exc, NmsmError) else f"{type(exc).__name__}: {exc}"
         outcome = RunOutcome(plan.name, FAILED, message=message, wall_time=time.perf_counter() - began,
                              worker=address, attempts=attempts, warnings=tuple(caught))
-        _write_json(record_path(plan), {"run": plan.name, "input_digest": None,
-                                        "finished": datetime.datetime.now().isoformat(timespec="seconds"),
-                                        "outcome": outcome.to_json()})
+        if not _after_failure(plan, exc):  # the record keeps the folder the batch's (never skipped)
+            _write_json(record_path(plan), {"run": plan.name, "input_digest": None,
+                                            "finished": datetime.datetime.now().isoformat(timespec="seconds"),
+                                            "outcome": outcome.to_json()})
         admin_path(plan, ".attempt.json").unlink(missing_ok=True)
         return outcome
-    except BaseException as exc:  # Ctrl-C: nothing of this attempt stays
-        _after_failure(plan, earlier, exc)
-        admin_path(plan, ".attempt.json").unlink(missing_ok=True)
+    except BaseException:  # Ctrl-C: nothing of this attempt stays
+        recover(plan)
         raise
-    if earlier is not None:
-        shutil.rmtree(earlier)
+    shutil.rmtree(admin_path(plan, ".earlier"), ignore_errors=True)
     status = SKIPPED if plan.kind == "pipeline" and _all_up_to_date(result) else OK
     outcome = RunOutcome(plan.name, status, wall_time=time.perf_counter() - began, worker=address,
                          attempts=attempts, warnings=tuple(caught), **headline(result, plan.folder))
