@@ -64,9 +64,10 @@ class BatchRun:
     outcomes: dict[str, RunOutcome]
     summary_file: Path
     figures: tuple[Path, ...]
-    wall_time: float  #: s, from the first submission to the last outcome
+    wall_time: float  #: s, from the first check of a run to the last outcome (the cluster's start included)
     workers: int
     dashboard: str | None
+    startup_time: float = 0.0  #: s, starting or connecting to the cluster (0: no run needed a worker)
 
     def count(self, status: str) -> int:
         return sum(o.status == status for o in self.outcomes.values())
@@ -241,12 +242,15 @@ class _Cluster:
         self.stack = contextlib.ExitStack()
         self.client: Any = None
         self.count, self.dashboard = 0, None
+        self.startup_time = 0.0
         self.events: queue.Queue = queue.Queue()
 
     def get(self) -> Any:
         if self.client is None:
+            began = time.perf_counter()
             client, self.count, self.dashboard, _ = self.stack.enter_context(
                 connect(self.workers, self.scheduler, self.timeout))
+            self.startup_time = time.perf_counter() - began
             client.subscribe_topic(EVENT_TOPIC, lambda event: self.events.put(event[1]))
             self.say(f"{self.count} Dask worker(s)" + (f"; dashboard {self.dashboard}" if self.dashboard else ""))
             self.client = client
@@ -368,7 +372,8 @@ def run_batch(batch_file: str | os.PathLike[str], *, results_directory: str | os
     wall = time.perf_counter() - began
     summary, figures = _write_outputs(spec, plans, outcomes)
     outcomes = {plan.name: outcomes[plan.name] for plan in plans}  # the batch file's order
-    return BatchRun(spec, tuple(plans), outcomes, summary, tuple(figures), wall, cluster.count, cluster.dashboard)
+    return BatchRun(spec, tuple(plans), outcomes, summary, tuple(figures), wall, cluster.count, cluster.dashboard,
+                    cluster.startup_time)
 
 
 def _write_outputs(spec: BatchSpec, plans: list[RunPlan], outcomes: dict[str, RunOutcome]) -> tuple[Path, list[Path]]:

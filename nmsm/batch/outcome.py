@@ -21,6 +21,13 @@ def _number(value: Any) -> float | None:
     return number if math.isfinite(number) else None
 
 
+def _count(value: Any) -> int | None:
+    try:
+        return None if value is None else int(value)
+    except (TypeError, ValueError):
+        return None
+
+
 @attrs.frozen
 class RunOutcome:
     """One run's status and headline figures.
@@ -37,8 +44,8 @@ class RunOutcome:
     name: str
     status: str
     message: str = ""
-    ipopt_status: str = ""
-    iterations: int | None = None
+    ipopt_status: str = attrs.field(default="", converter=str)
+    iterations: int | None = attrs.field(default=None, converter=_count)
     objective: float | None = attrs.field(default=None, converter=_number)
     initial_objective: float | None = attrs.field(default=None, converter=_number)
     tracking_rms: float | None = attrs.field(default=None, converter=_number)

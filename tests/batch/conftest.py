@@ -14,7 +14,7 @@ from nmsm.examples.synthetic_jmp import make_synthetic_jmp_case
 def jmp_case(tmp_path_factory):
     """A synthetic JMP case (``settings_file``, markers, models) and a copy of its settings with
     a value JMP cannot read (``broken.xml``)."""
-    case = make_synthetic_jmp_case(tmp_path_factory.mktemp("jmp_case"))
+    case = make_synthetic_jmp_case(tmp_path_factory.mktemp("jmp_case"), duration=1.0)
     text = case.settings_file.read_text(encoding="utf-8")
     broken = text.replace("<max_function_evaluations>500", "<max_function_evaluations>lots")
     assert broken != text
