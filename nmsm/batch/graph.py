@@ -9,13 +9,16 @@ dependency cycle, and two runs whose results folders are the same or one inside 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import attrs
 
 from nmsm.batch.batch_file import BatchSpec, Entry
 from nmsm.batch.sweep import RunPlan
 
 
-def _warm_start(spec: BatchSpec, entry: Entry, plans: dict[str, RunPlan], by_entry: dict[str, list[RunPlan]]):
+def _warm_start(spec: BatchSpec, entry: Entry, plans: dict[str, RunPlan],
+                by_entry: dict[str, list[RunPlan]]) -> tuple[str, Path]:
     """``(parent run name, its results folder or the stage folder in it)``."""
     target = entry.warm_start_from
     assert target is not None

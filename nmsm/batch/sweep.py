@@ -23,12 +23,17 @@ import itertools
 import re
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import attrs
 
 from nmsm.batch.batch_file import BatchSpec, Entry, Parameter
 from nmsm.errors import InputError, NmsmError
 from nmsm.io.xml_input import set_element_text
+
+if TYPE_CHECKING:
+    from nmsm.tools.pipeline.kinds import StageKind
+    from nmsm.tools.pipeline.stage_settings import StageSettings
 
 #: the path element a warm start sets
 WARM_START_ELEMENT = "initial_guess_directory"
@@ -104,7 +109,7 @@ def expand(spec: BatchSpec) -> list[RunPlan]:
     return plans
 
 
-def tool_kind(settings_file: Path):
+def tool_kind(settings_file: Path) -> StageKind:
     """The pipeline stage kind (:mod:`nmsm.tools.pipeline.kinds`) of a settings file."""
     from nmsm.tools.dispatch import tool_element_name
     from nmsm.tools.pipeline.kinds import kind_for_element
@@ -112,7 +117,7 @@ def tool_kind(settings_file: Path):
     return kind_for_element(tool_element_name(settings_file), file=settings_file)
 
 
-def load_settings(plan: RunPlan, *, variant: bool = True):
+def load_settings(plan: RunPlan, *, variant: bool = True) -> tuple[StageKind, StageSettings]:
     """The run's settings as its tool will read them (module docstring); ``variant=False``:
     the settings file without the swept values and the warm start, only the results folder set."""
     from nmsm.io.settings.document import TOOL_ELEMENTS
@@ -138,7 +143,7 @@ def settings_text(plan: RunPlan) -> str:
     return settings.text(plan.settings_copy, plan.results_root)
 
 
-def _parse(kind, settings) -> None:
+def _parse(kind: StageKind, settings: StageSettings) -> None:
     """:class:`InputError` (or another :class:`NmsmError`) when the tool would refuse ``settings``."""
     from nmsm.tools.pipeline.validation import parse_settings
 
@@ -150,7 +155,7 @@ def _parse(kind, settings) -> None:
             check(parsed)
 
 
-def _check_elements(spec: BatchSpec, entry: Entry, settings) -> None:
+def _check_elements(spec: BatchSpec, entry: Entry, settings: StageSettings) -> None:
     """Every swept element path matches exactly one element of the settings file."""
     tool = settings.tool
     for parameter in entry.parameters:
