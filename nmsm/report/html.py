@@ -13,7 +13,10 @@ the results tree and never writes into it (the page itself goes where it is told
 default ``<results>/report.html``). A tree with several treatment stages (TO, VO, DO) ends
 with their comparison: the first one's kinematics and ground reactions with the others
 drawn on them, against the experimental data (:func:`treatment_comparison`). The example
-adds its known-answer comparison (collapsed, under the status table).
+adds its known-answer comparison (collapsed, under the status table). A batch's results
+folder (``nmsm batch``) leads with its summary and the figure of each sweep's design goal
+against the varied value (:func:`batch_view`, ``batch.html.j2``); its runs' sections show
+their tables and only the figures ``nmsm plot`` drew into them, without a comparison.
 
 The page is rendered with Jinja2 from the templates in ``nmsm/report/templates``:
 ``report.html.j2`` (the page), ``status.html.j2``, ``checks.html.j2``, ``table.html.j2``
@@ -107,14 +110,15 @@ def _stages(root: Path) -> list[StageView]:
                       label=tool) for tool, folder in results_folders(root)]
 
 
-def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], None] | None) -> list[Path]:
-    """The PNGs of ``folder/plots``, or (none there) those the tool's plot module draws into
-    ``scratch`` (a new folder outside the results tree)."""
+def _figures(section: str, folder: Path, scratch: Path, log: Callable[[str], None] | None, *,
+             draw: bool = True) -> list[Path]:
+    """The PNGs of ``folder/plots``, or (none there, and ``draw``) those the tool's plot module
+    draws into ``scratch`` (a new folder outside the results tree)."""
     from nmsm.plots.cli import PLOTTERS
 
     plots = folder / "plots"
     existing = sorted(plots.glob("*.png")) if plots.is_dir() else []
-    if existing:
+    if existing or not draw:
         return existing
     tool = "treatment" if section == "treatment" else section
     plotter = next((p for p in PLOTTERS if p.tool == tool), None)
@@ -133,8 +137,9 @@ def _figure(path: Path) -> Figure:
     return Figure(Path(path).name, f"data:image/png;base64,{data}")
 
 
-def _fill(stage: StageView, scratch: Path, log: Callable[[str], None] | None) -> None:
-    """Read one stage's status, tables, texts and figures (drawn into ``scratch`` if need be)."""
+def _fill(stage: StageView, scratch: Path, log: Callable[[str], None] | None, *, draw: bool = True) -> None:
+    """Read one stage's status, tables, texts and figures (drawn into ``scratch`` if need be
+    and ``draw``)."""
     if stage.kind is None:
         return
     stage.status = stage_status(stage.kind, stage.folder)
@@ -146,7 +151,7 @@ def _fill(stage: StageView, scratch: Path, log: Callable[[str], None] | None) ->
             parts = [ReportText("tables unavailable", f"{type(exc).__name__}: {exc}")]
         stage.tables = [p for p in parts if isinstance(p, ReportTable)]
         stage.texts = [p for p in parts if isinstance(p, ReportText)]
-    stage.figures = [_figure(p) for p in _figures(stage.kind, stage.folder, scratch, log)]
+    stage.figures = [_figure(p) for p in _figures(stage.kind, stage.folder, scratch, log, draw=draw)]
 
 
 def treatment_comparison(stages: Sequence[StageView], scratch: Path, log: Callable[[str], None] | None
@@ -174,6 +179,33 @@ def treatment_comparison(stages: Sequence[StageView], scratch: Path, log: Callab
     return view
 
 
+#: columns of the batch summary shown in the report (after the run and the swept parameters)
+BATCH_COLUMNS = ("status", "ipopt_status", "iterations", "objective", "objective_change", "tracking_rms_deg",
+                 "wall_time_s", "attempts", "message")
+
+
+def batch_view(root: Path, scratch: Path) -> dict[str, Any]:
+    """The batch section of ``root`` (``batch_summary.csv`` of ``nmsm batch``,
+    :mod:`nmsm.batch.summary`): the summary table and the figure of each sweep
+    (``plots/sweep_*.png``, or drawn into ``scratch``)."""
+    from nmsm.batch.summary import SUMMARY_FILE, draw_sweeps, parameter_columns, read_summary
+
+    columns, rows = read_summary(root / SUMMARY_FILE)
+    shown = ["run", *parameter_columns(columns), *BATCH_COLUMNS]
+    counts = ", ".join(f"{sum(r['status'] == s for r in rows)} {s}" for s in dict.fromkeys(r["status"] for r in rows))
+    table = ReportTable(f"{len(rows)} runs ({counts})", tuple(shown),
+                        tuple(tuple(r.get(c, "")[:200] for c in shown) for r in rows),
+                        note=f"{root / SUMMARY_FILE}; design goal = the final objective, its change from the "
+                             "starting point (the parent's results for a warm start); tracking RMS = modeled - "
+                             "tracked coordinates (deg). Each run's section below shows its figures when "
+                             "nmsm plot has drawn them into its folder.")
+    figures = sorted((root / "plots").glob("sweep_*.png"))
+    if not figures:
+        scratch.mkdir(parents=True, exist_ok=True)
+        figures = draw_sweeps(columns, rows, scratch)
+    return {"table": table, "figures": [_figure(p) for p in figures]}
+
+
 def _environment() -> Any:
     import jinja2
 
@@ -189,14 +221,14 @@ def _checks_view(checks: Sequence) -> dict[str, Any]:
 
 
 def render_report(root: Path, stages: Sequence[StageView], *, checks: Sequence | None = None,
-                  title: str | None = None) -> str:
+                  title: str | None = None, batch: dict[str, Any] | None = None) -> str:
     """The page's HTML for ``stages`` (already filled) of the results tree ``root``."""
     from nmsm import __version__
 
     return _environment().get_template("report.html.j2").render(
         title=title or f"nmsm report: {'/'.join(root.resolve().parts[-2:])}", root=str(root.resolve()),
         written=datetime.datetime.now().isoformat(timespec="seconds"), version=__version__,
-        stages=list(stages), checks=_checks_view(checks) if checks else None)
+        stages=list(stages), checks=_checks_view(checks) if checks else None, batch=batch)
 
 
 def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str] | None = None, *,
@@ -208,17 +240,22 @@ def write_report(results: str | os.PathLike[str], output: str | os.PathLike[str]
     root = Path(results)
     if not root.is_dir():
         raise InputError("not a folder", file=root, expected="a results folder")
+    from nmsm.batch.summary import SUMMARY_FILE
+
+    is_batch = (root / SUMMARY_FILE).is_file()
     stages = _stages(root)
-    if not any(s.has_section for s in stages) and not checks:
+    if not any(s.has_section for s in stages) and not checks and not is_batch:
         raise InputError("no results of JMP, MTP, NCP, GCP or treatment optimization found", file=root,
                          expected="a pipeline results tree or a tool's results folder")
     with tempfile.TemporaryDirectory(prefix="nmsm-report-") as drawn:
+        # a batch's runs: their tables, only the figures `nmsm plot` drew, no comparison (many runs)
+        batch = batch_view(root, Path(drawn) / "batch") if is_batch else None
         for k, stage in enumerate(stages):
-            _fill(stage, Path(drawn) / str(k), log)
-        comparison = treatment_comparison(stages, Path(drawn) / "comparison", log)
+            _fill(stage, Path(drawn) / str(k), log, draw=not is_batch)
+        comparison = None if is_batch else treatment_comparison(stages, Path(drawn) / "comparison", log)
         if comparison is not None:
             stages.append(comparison)
-        page = render_report(root, stages, checks=checks, title=title)
+        page = render_report(root, stages, checks=checks, title=title, batch=batch)
     target = Path(output) if output is not None else root / REPORT_FILE
     write_output(target, page)
     return target
