@@ -8,6 +8,7 @@ from pathlib import Path
 
 from nmsm import __version__
 from nmsm.cli import build_parser, main
+from nmsm.core.progress import DEFAULT_INTERVAL
 
 
 def test_python_dash_m_runs_the_command_line():
@@ -18,7 +19,7 @@ def test_python_dash_m_runs_the_command_line():
 
 def test_progress_interval_option():
     parser = build_parser()
-    assert parser.parse_args(["plugins"]).progress == 10.0
+    assert parser.parse_args(["plugins"]).progress == DEFAULT_INTERVAL == 5.0
     assert parser.parse_args(["--progress", "0", "plugins"]).progress == 0.0
     assert parser.parse_args(["--progress", "2.5", "plugins"]).progress == 2.5
 
