@@ -7,6 +7,9 @@ solver files of :mod:`nmsm.examples.fullbody_settings`; prints the TO settings p
 them in order with ``nmsm run``: each tool's results go to ``DIR/<case>_<mesh>/results/<tool>``
 and the next tool reads them.
 
+``--quick`` (tests): no GCP runs (the GCP tutorial's right foot and its mirror image) and
+fewer surrogate samples; settings in ``DIR/<case>_<mesh>_quick/``.
+
 Cases: ``stress`` (86 muscles synergy-driven, 5 + 5 synergies from an NCP of
 static-optimization activations: synthetic) and ``combined`` (the NCP tutorial's right-leg
 synergies, torques elsewhere). Meshes: ``full`` (25 intervals x 4 points) and ``coarse``
@@ -54,15 +57,21 @@ def synergy_pairs(ncp_results: Path) -> tuple[tuple[str, str], ...]:
     return tuple((names[right[i]], names[left[j]]) for i, j in zip(rows, cols))
 
 
-def stress_case(folder: Path, shared: fd.SharedInputs) -> tuple[Controllers, fp.Prepared, Path, Path, Path]:
+def _suffix(quick: bool) -> str:
+    return "_quick" if quick else ""
+
+
+def stress_case(folder: Path, shared: fd.SharedInputs,
+                quick: bool = False) -> tuple[Controllers, fp.Prepared, Path, Path, Path]:
     prepared = fp.Prepared(folder)
     fp.prepare_model(shared, prepared)
     fp.prepare_data(shared, prepared)
-    for side in fd.SIDES:
-        fp.prepare_gcp(shared, prepared, side)
+    feet = fp.prepare_contact(shared, prepared, quick)
     ncp = fp.prepare_stress_synergies(prepared)
-    surrogate = fp.prepare_surrogate(prepared, "surrogate_stress", prepared.model, fd.muscle_coordinates())
-    osimx = fp.merged_osimx(prepared, "stress", next(ncp.glob("*.osimx")))
+    surrogate = fp.prepare_surrogate(prepared, "surrogate_stress" + _suffix(quick), prepared.model,
+                                     fd.muscle_coordinates(),
+                                     samples_per_frame=fp.QUICK_SAMPLES_PER_FRAME if quick else None)
+    osimx = fp.merged_osimx(prepared, "stress" + _suffix(quick), next(ncp.glob("*.osimx")), feet)
     from nmsm.model import load_model
 
     pairs = synergy_pairs(ncp)
@@ -74,14 +83,16 @@ def stress_case(folder: Path, shared: fd.SharedInputs) -> tuple[Controllers, fp.
     return controllers, prepared, osimx, ncp, surrogate
 
 
-def combined_case(folder: Path, shared: fd.SharedInputs) -> tuple[Controllers, fp.Prepared, Path, Path, Path]:
+def combined_case(folder: Path, shared: fd.SharedInputs,
+                  quick: bool = False) -> tuple[Controllers, fp.Prepared, Path, Path, Path]:
     prepared = fp.Prepared(folder)
     fp.prepare_model(shared, prepared)
     fp.prepare_data(shared, prepared)
-    for side in fd.SIDES:
-        fp.prepare_gcp(shared, prepared, side)
-    surrogate = fp.prepare_surrogate(prepared, "surrogate_combined", shared.ncp_model, fp.COMBINED_SURROGATE)
-    osimx = fp.merged_osimx(prepared, "combined", shared.ncp_osimx)
+    feet = fp.prepare_contact(shared, prepared, quick)
+    surrogate = fp.prepare_surrogate(prepared, "surrogate_combined" + _suffix(quick), shared.ncp_model,
+                                     fp.COMBINED_SURROGATE,
+                                     samples_per_frame=fp.QUICK_SAMPLES_PER_FRAME if quick else None)
+    osimx = fp.merged_osimx(prepared, "combined" + _suffix(quick), shared.ncp_osimx, feet)
     from nmsm.io.osimx import read_osimx
 
     synergies = read_osimx(shared.ncp_osimx).synergies
@@ -99,8 +110,10 @@ def combined_case(folder: Path, shared: fd.SharedInputs) -> tuple[Controllers, f
 
 
 def write_case(folder: str | os.PathLike[str], case: str = "stress", mesh: str = "full",
-               shared_root: str | os.PathLike[str] | None = None) -> dict[str, Path]:
-    """Prepare ``folder`` and write the case's settings; the settings paths by tool."""
+               shared_root: str | os.PathLike[str] | None = None, *, quick: bool = False) -> dict[str, Path]:
+    """Prepare ``folder`` and write the case's settings into ``folder/<case>_<mesh>[_quick]``;
+    the settings paths by tool. ``quick``: :mod:`nmsm.examples.fullbody_prepare`'s quick
+    preparation (mirrored tutorial contact, fewer surrogate samples; for tests)."""
     if case not in CASES:
         raise ValueError(f"case must be one of {CASES}, got '{case}'")
     if mesh not in MESHES:
@@ -109,8 +122,8 @@ def write_case(folder: str | os.PathLike[str], case: str = "stress", mesh: str =
     folder.mkdir(parents=True, exist_ok=True)
     shared = fd.shared_inputs(shared_root)
     build = stress_case if case == "stress" else combined_case
-    controllers, prepared, osimx, guess, surrogate = build(folder, shared)
-    settings = folder / f"{case}_{mesh}"
+    controllers, prepared, osimx, guess, surrogate = build(folder, shared, quick)
+    settings = folder / f"{case}_{mesh}{_suffix(quick)}"
     model = prepared.model if case == "stress" else shared.ncp_model
     folders = CaseFolders(settings=settings, model=model, osimx=osimx, tracked=prepared.data, guess=guess,
                           surrogate=surrogate, results=settings / "results")
@@ -125,8 +138,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     write.add_argument("--case", choices=CASES, default="stress")
     write.add_argument("--mesh", choices=tuple(MESHES), default="full")
     write.add_argument("--shared", default=None, help="shared data folder (default $NMSM_SHARED_DATA or /work/shared/data)")
+    write.add_argument("--quick", action="store_true",
+                       help="no GCP runs (the tutorial's right foot and its mirror) and fewer surrogate samples")
     args = parser.parse_args(argv)
-    paths = write_case(args.folder, args.case, args.mesh, args.shared)
+    paths = write_case(args.folder, args.case, args.mesh, args.shared, quick=args.quick)
     for tool, path in paths.items():
         print(f"{tool.upper()}: {path}")
     return 0

@@ -76,6 +76,11 @@ class SharedInputs:
         return self.preprocessed / "GRFData" / f"{TRIAL}.sto"
 
     @property
+    def gcp_result(self) -> Path:
+        """The original's GCP result of the right foot (tutorial V4), for quick cases."""
+        return self.gcp_settings.parent / "GCPResultsV4" / "bodyModel_gcp.osimx"
+
+    @property
     def ncp_model(self) -> Path:
         return self.ncp_folder / "UF_Subject_3_reduced_muscles.osim"
 
@@ -107,6 +112,7 @@ def shared_inputs(root: str | os.PathLike[str] | None = None) -> SharedInputs:
         ncp_folder=root / "ncp" / "uf_subject3_tutorial",
     )
     for path in (inputs.body_model, inputs.muscle_model, inputs.ik, inputs.id, inputs.grf, inputs.gcp_settings,
+                 inputs.gcp_result,
                  inputs.ncp_model, inputs.ncp_osimx, inputs.ncp_results / "synergyWeights.sto"):
         if not path.is_file():
             raise InputError(f"{path} does not exist", element="shared data",

@@ -6,6 +6,11 @@ tutorial's surface (plate 2), the left foot gets plate 1's columns, ``calcn_l`` 
 left markers (``L_Toe_Medial``/``L_Toe_Lateral`` are the mirrored markers of
 :mod:`nmsm.examples.fullbody_model`). Each foot runs as its own GCP (one surface per
 settings file); :func:`merge_contact` puts both feet's surfaces into the synergy ``.osimx``.
+
+Without GCP runs (``quick`` cases, for tests): :func:`mirrored_surface` makes a left foot
+from a right foot's surface (the GCP tutorial's result): springs on ``calcn_l``/``toes_l``
+at the mirrored locations (``z -> -z``), plate 1's columns, the left markers, the same
+spring constants and contact properties.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ import attrs
 
 from nmsm.errors import InputError
 from nmsm.examples.subject_settings import _relative
-from nmsm.io.osimx import OsimxModel, read_osimx, write_osimx
+from nmsm.io.osimx import OsimxContactSurface, OsimxModel, read_osimx, write_osimx
 
 #: per foot: surface name, force plate number, hindfoot body, marker prefix
 FEET = {"r": ("Right foot", 2, "calcn_r", "R"), "l": ("Left foot", 1, "calcn_l", "L")}
@@ -71,3 +76,42 @@ def merge_contact(osimx: str | os.PathLike[str], feet: Sequence[str | os.PathLik
     base: OsimxModel = read_osimx(osimx)
     surfaces = tuple(s for f in feet for s in read_osimx(f).contact_surfaces)
     return write_osimx(output, attrs.evolve(base, contact_surfaces=base.contact_surfaces + surfaces))
+
+
+def _left(name: str) -> str:
+    return name[:-2] + "_l" if name.endswith("_r") else name
+
+
+def mirrored_surface(surface: OsimxContactSurface) -> OsimxContactSurface:
+    """The left-foot mirror image of a right foot's contact surface (module docstring)."""
+    if surface.is_left_foot:
+        raise InputError("the surface to mirror is a left foot", element="<is_left_foot>", expected="a right foot")
+    _, plate, hindfoot, prefix = FEET["l"]
+    springs = tuple(attrs.evolve(k, parent_body=_left(k.parent_body),
+                                 location=(k.location[0], k.location[1], -k.location[2])) for k in surface.springs)
+    marker = lambda name: prefix + name[1:] if name.startswith("R_") else name  # noqa: E731
+    return attrs.evolve(
+        surface, is_left_foot=True, hindfoot_body=hindfoot, springs=springs,
+        force_columns=tuple(f"ground_force_{plate}_v{a}" for a in "xyz"),
+        moment_columns=tuple(f"ground_moment_{plate}_m{a}" for a in "xyz"),
+        electrical_center_columns=tuple(f"ground_force_{plate}_p{a}" for a in "xyz"),
+        toe_marker=marker(surface.toe_marker), medial_marker=marker(surface.medial_marker),
+        lateral_marker=marker(surface.lateral_marker), heel_marker=marker(surface.heel_marker),
+        midfoot_superior_marker=marker(surface.midfoot_superior_marker))
+
+
+def write_mirrored_feet(right_osimx: str | os.PathLike[str], folder: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """``folder/right_gcp.osimx`` (the right foot's surfaces of ``right_osimx``) and
+    ``folder/left_gcp.osimx`` (their mirror images)."""
+    source = read_osimx(right_osimx)
+    right = tuple(s for s in source.contact_surfaces if not s.is_left_foot)
+    if not right:
+        raise InputError("no right-foot contact surface", file=right_osimx, element="<RCNLContactSurfaceSet>",
+                         expected="a GCP result of the right foot")
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    base = attrs.evolve(source, muscles={}, synergies=())
+    paths = (folder / "right_gcp.osimx", folder / "left_gcp.osimx")
+    write_osimx(paths[0], attrs.evolve(base, contact_surfaces=right))
+    write_osimx(paths[1], attrs.evolve(base, contact_surfaces=tuple(mirrored_surface(s) for s in right)))
+    return paths

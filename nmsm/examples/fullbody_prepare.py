@@ -14,6 +14,12 @@ step leaves nothing that looks finished):
 * combined case: ``prepared/surrogate_combined`` (the NCP tutorial's 9 muscles x 6
   right-leg coordinates) and ``prepared/fullbody_combined.osimx`` (the NCP tutorial's osimx
   + both feet).
+
+Quick preparation (``quick=True``, for tests: about a minute instead of about ten): no GCP
+runs - the GCP tutorial's right-foot result and its mirror image
+(:func:`nmsm.examples.fullbody_gcp.write_mirrored_feet`, ``prepared/contact_mirrored``) -
+and ``QUICK_SAMPLES_PER_FRAME`` surrogate poses per frame instead of ``nmsm surrogate``'s 25;
+its artifacts carry ``_quick`` in their names.
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ import numpy as np
 from nmsm.examples import fullbody_data as fd
 from nmsm.examples.fullbody_activations import (model_parameters, read_trial, static_optimization,
                                                 tendon_slack_lengths, write_activations)
-from nmsm.examples.fullbody_gcp import gcp_settings_xml, merge_contact
+from nmsm.examples.fullbody_gcp import gcp_settings_xml, merge_contact, write_mirrored_feet
 from nmsm.examples.fullbody_model import write_fullbody_model
 from nmsm.examples.fullbody_ncp import ncp_settings_xml, write_muscle_osimx
 
@@ -40,6 +46,8 @@ from nmsm.examples.fullbody_ncp import ncp_settings_xml, write_muscle_osimx
 COMBINED_SURROGATE = ("hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r",
                       "subtalar_angle_r")
 STRESS_SYNERGIES = 5
+#: surrogate poses per motion frame of quick cases (101 frames)
+QUICK_SAMPLES_PER_FRAME = 3
 
 
 def _log(message: str) -> None:
@@ -160,21 +168,33 @@ def prepare_stress_synergies(prepared: Prepared) -> Path:
     return _step(prepared.path("ncp"), "NCP (5 + 5 synergies)", make_ncp)
 
 
-def prepare_surrogate(prepared: Prepared, name: str, model: Path, coordinates: tuple[str, ...]) -> Path:
-    """Surrogate samples (``nmsm surrogate --motion ... --write-samples``) of ``model``."""
+def prepare_surrogate(prepared: Prepared, name: str, model: Path, coordinates: tuple[str, ...], *,
+                      samples_per_frame: int | None = None) -> Path:
+    """Surrogate samples (``nmsm surrogate --motion ... --write-samples``) of ``model``
+    (``samples_per_frame``: ``nmsm surrogate``'s default when None)."""
     fit = prepared.path(f"{name}_fit.json")
 
     def make(out: Path) -> None:
         if fit.exists():
             fit.unlink()
+        extra = [] if samples_per_frame is None else ["--samples-per-frame", str(samples_per_frame)]
         _nmsm("surrogate", "--model", str(model), "--motion", str(prepared.data / "IKData" / f"{fd.TRIAL}.sto"),
-              "--coordinates", *coordinates, "--write-samples", str(out), "-o", str(fit))
+              "--coordinates", *coordinates, "--write-samples", str(out), "-o", str(fit), *extra)
 
     return _step(prepared.path(name), f"surrogate samples ({name})", make)
 
 
-def merged_osimx(prepared: Prepared, name: str, synergy_osimx: Path) -> Path:
-    feet = [_gcp_osimx(prepared.path(f"gcp_{s}")) for s in fd.SIDES]
+def prepare_contact(shared: fd.SharedInputs, prepared: Prepared, quick: bool) -> list[Path]:
+    """The ``.osimx`` of each foot's contact: GCP runs, or (``quick``) the tutorial's right
+    foot and its mirror image."""
+    if quick:
+        folder = _step(prepared.path("contact_mirrored"), "contact: GCP tutorial's right foot and its mirror",
+                       lambda out: write_mirrored_feet(shared.gcp_result, out))
+        return [folder / "right_gcp.osimx", folder / "left_gcp.osimx"]
+    return [_gcp_osimx(prepare_gcp(shared, prepared, side)) for side in fd.SIDES]
+
+
+def merged_osimx(prepared: Prepared, name: str, synergy_osimx: Path, feet: list[Path]) -> Path:
     return _step(prepared.path(f"fullbody_{name}.osimx"), f"osimx with both feet ({name})",
                  lambda out: merge_contact(synergy_osimx, feet, out))
 
