@@ -77,11 +77,15 @@ def _limit(gigabytes: float):
     return apply
 
 
+TIMING_LINE = re.compile(r"\s*([A-Za-z][A-Za-z \-]+?)\s*\.+:\s*([\d.eE+-]+)\s*"
+                         r"\(sys:\s*[\d.eE+-]+\s*wall:\s*([\d.eE+-]+)\)")
+
+
 def ipopt_timing(text: str) -> dict[str, float]:
     """Wall seconds of IPOPT's ``print_timing_statistics`` lines (``name....: cpu wall``)."""
     out = {}
     for line in text.splitlines():
-        m = re.match(r"\s*([A-Za-z][A-Za-z \-]+?)\s*\.+:\s*([\d.eE+-]+)\s*\(sys:\s*[\d.eE+-]+\s*wall:\s*([\d.eE+-]+)\)", line)
+        m = TIMING_LINE.match(line)
         if m:
             out[m.group(1).strip()] = float(m.group(3))
     return out
@@ -117,7 +121,8 @@ def time_surrogate(folder: Path, memory_gb: float) -> dict:
     out.mkdir()
     before = load_average()
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "nmsm", "surrogate", "--model", str(folder / "model" / "fullbody.osim"),
+    model = folder / "model" / "fullbody.osim"
+    proc = subprocess.run([sys.executable, "-m", "nmsm", "surrogate", "--model", str(model),
                            "--motion", str(folder / "data" / "IKData" / f"{fd.TRIAL}.sto"), "--coordinates",
                            *fd.muscle_coordinates(), "--write-samples", str(out / "samples"), "-o",
                            str(out / "surrogate.json")], capture_output=True, text=True, preexec_fn=_limit(memory_gb),
@@ -143,7 +148,8 @@ def print_rows(rows: list[dict]) -> None:
         other = per - ev_it if it else float("nan")
         target = TARGETS[r["tool"]][1]
         print(f"| {r['tool'].upper()} | {r['status'][:60]} | {r.get('variables', '')} | "
-              f"{r.get('build_s', float('nan')):.1f} ({BUILD_TARGET_S:g}) | {it} | {r.get('solve_s', float('nan')):.1f} | "
+              f"{r.get('build_s', float('nan')):.1f} ({BUILD_TARGET_S:g}) | {it} | "
+              f"{r.get('solve_s', float('nan')):.1f} | "
               f"{per:.2f} | {ev_it:.2f} | {other:.2f} | {r['total_s']:.1f} ({target:g}) | "
               f"{r.get('peak_rss_gb', float('nan')):.2f} | {r['load_before']} / {r['load_after']} |")
     print("\nreferences:")

@@ -137,7 +137,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     write.add_argument("folder", help="case folder (created; prepared inputs are reused when present)")
     write.add_argument("--case", choices=CASES, default="stress")
     write.add_argument("--mesh", choices=tuple(MESHES), default="full")
-    write.add_argument("--shared", default=None, help="shared data folder (default $NMSM_SHARED_DATA or /work/shared/data)")
+    write.add_argument("--shared", default=None,
+                       help="shared data folder (default $NMSM_SHARED_DATA or /work/shared/data)")
     write.add_argument("--quick", action="store_true",
                        help="no GCP runs (the tutorial's right foot and its mirror) and fewer surrogate samples")
     args = parser.parse_args(argv)

@@ -133,7 +133,8 @@ def _controllers_xml(controllers: Controllers, folders: CaseFolders, optimize_ve
       <optimize_synergy_vectors>{"true" if optimize_vectors else "false"}</optimize_synergy_vectors>
       <synergy_vector_normalization_method>sum</synergy_vector_normalization_method>
       <synergy_vector_normalization_value>1</synergy_vector_normalization_value>
-      <maximum_allowable_synergy_activation>{controllers.max_synergy_activation:g}</maximum_allowable_synergy_activation>
+      <maximum_allowable_synergy_activation>{controllers.max_synergy_activation:g}\
+</maximum_allowable_synergy_activation>
     </RCNLSynergyController>
     <RCNLTorqueController>
       <coordinate_list>{" ".join(controllers.torque_coordinates)}</coordinate_list>
@@ -210,13 +211,15 @@ def treatment_xml(tool: str, controllers: Controllers, folders: CaseFolders) -> 
     <model_functions>scaleSynergyActivation</model_functions>
     <RCNLParameterTermSet><RCNLParameterTerm><type>paretic_synergy_scale</type>
       <synergy>{controllers.paretic}</synergy><initial_values>1</initial_values>
-      <lower_bounds>{low:g}</lower_bounds><upper_bounds>{high:g}</upper_bounds></RCNLParameterTerm></RCNLParameterTermSet>
+      <lower_bounds>{low:g}</lower_bounds><upper_bounds>{high:g}</upper_bounds>
+    </RCNLParameterTerm></RCNLParameterTermSet>
     <RCNLCostTermSet>{costs}</RCNLCostTermSet>
     <RCNLConstraintTermSet>{_dynamics_constraints(controllers)}{_initial_state()}</RCNLConstraintTermSet>
   </DesignOptimizationTool>"""
     else:
         raise ValueError(f"tool must be one of {TOOLS}, got '{tool}'")
-    return f'<?xml version="1.0" encoding="UTF-8"?>\n{header}\n<NMSMPipelineDocument Version="1.5.3">\n  {body}\n</NMSMPipelineDocument>\n'
+    return (f'<?xml version="1.0" encoding="UTF-8"?>\n{header}\n<NMSMPipelineDocument Version="1.5.3">\n'
+            f"  {body}\n</NMSMPipelineDocument>\n")
 
 
 def write_treatment_settings(controllers: Controllers, folders: CaseFolders, mesh: str) -> dict[str, Path]:

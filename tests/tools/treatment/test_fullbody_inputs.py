@@ -125,7 +125,8 @@ def _stress_controllers():
 
     pairs = tuple((f"right_leg_{k}", f"left_leg_{k}") for k in range(1, 6))
     return Controllers(name="stress", synergy_names=tuple(n for p in pairs for n in p),
-                       surrogate_coordinates=fd.muscle_coordinates(), torque_coordinates=fd.LUMBAR + fd.arm_coordinates(),
+                       surrogate_coordinates=fd.muscle_coordinates(),
+                       torque_coordinates=fd.LUMBAR + fd.arm_coordinates(),
                        muscles=("soleus_r", "soleus_l"), optimize_vectors=True, max_synergy_activation=10,
                        pairs=pairs, paretic="right_leg_1")
 
