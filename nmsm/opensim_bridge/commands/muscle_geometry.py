@@ -317,8 +317,8 @@ def muscle_length_gradients(
     ``dL/dq_c`` along the coupler); a dependent coordinate named in ``wrt`` is perturbed
     alone (partial derivative).
 
-    Spanned coordinates: the first, middle and last poses are differentiated for every
-    muscle; a muscle whose ``|dL/dq_c|`` stays below ``SPAN_THRESHOLD`` at all three does not
+    Spanned coordinates (without ``moment_arms``): the first, middle and last poses are
+    differentiated for every muscle; a muscle whose ``|dL/dq_c|`` stays below ``SPAN_THRESHOLD`` at all three does not
     span ``c`` (its length changes only by round-off when ``c`` moves) and gets exactly 0
     there (at the other poses without being computed). With 86 leg muscles and 14 leg
     coordinates each muscle spans 1-4 of them.
@@ -340,7 +340,13 @@ def muscle_length_gradients(
     rows = _poses(q, len(setter.coordinates))
     lengths = np.zeros((len(rows), len(chosen)))
     grad = np.zeros((len(rows), len(chosen), len(wrt)))
-    probes = sorted({0, len(rows) // 2, len(rows) - 1}) if len(rows) else []
+    # with ``moment_arms`` every pose is differentiated for every muscle: MuscleAnalysis's
+    # moment arms are computed wherever a length changes at all, round-off included
+    restrict = not moment_arms
+    if not len(rows):
+        probes: list[int] = []
+    else:
+        probes = sorted({0, len(rows) // 2, len(rows) - 1}) if restrict else list(range(len(rows)))
     spans = np.zeros((len(chosen), len(wrt)), dtype=bool)
     every = np.arange(len(chosen))
 
@@ -364,7 +370,7 @@ def muscle_length_gradients(
             which = every if i in probes else np.flatnonzero(spans[:, k])
             if which.size:
                 differentiate(i, which, k, base)
-        if done == len(probes):
+        if restrict and done == len(probes):
             spans = np.any(np.abs(grad[probes]) >= SPAN_THRESHOLD, axis=0)
             for p in probes:
                 grad[p][~spans] = 0.0
