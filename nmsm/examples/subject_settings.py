@@ -236,16 +236,18 @@ SOLVER_XML = """<?xml version="1.0" encoding="UTF-8"?>
   <OptimalControlSolverSettings>
     <GpopsSettings>
       <setup_mesh_method>none</setup_mesh_method>
-      <setup_mesh_phase_intervals>1</setup_mesh_phase_intervals>
-      <setup_mesh_phase_colpoints_per_Interval>12</setup_mesh_phase_colpoints_per_Interval>
+      <setup_mesh_phase_intervals>{intervals}</setup_mesh_phase_intervals>
+      <setup_mesh_phase_colpoints_per_Interval>{points}</setup_mesh_phase_colpoints_per_Interval>
       <setup_nlp_solver>ipopt</setup_nlp_solver>
       <setup_nlp_linear_solver>mumps</setup_nlp_linear_solver>
       <setup_nlp_tolerance>{tolerance}</setup_nlp_tolerance>
-      <setup_nlp_max_iterations>300</setup_nlp_max_iterations>
+      <setup_nlp_max_iterations>{max_iterations}</setup_nlp_max_iterations>
     </GpopsSettings>
   </OptimalControlSolverSettings>
 </NMSMPipelineDocument>
 """
+#: the example's mesh (one interval of 12 collocation points) and iteration limit
+EXAMPLE_MESH = {"intervals": 1, "points": 12, "max_iterations": 300}
 #: IPOPT tolerance of the example's solver files: TO and VO ``solver.xml``, DO ``solver_do.xml``
 #: (Design Optimization applies at most 1e-6, ``solver_options.DESIGN_MAX_TOLERANCE``)
 SOLVER_TOLERANCES = {"solver.xml": "1e-3", "solver_do.xml": "1e-6"}
@@ -374,7 +376,8 @@ def write_example_pipeline(subject: Subject, folder: str | os.PathLike[str], *, 
     folder = Path(folder)
     (folder / "settings").mkdir(parents=True, exist_ok=True)
     for name, tolerance in SOLVER_TOLERANCES.items():
-        (folder / "settings" / name).write_text(SOLVER_XML.format(tolerance=tolerance), encoding="utf-8")
+        (folder / "settings" / name).write_text(SOLVER_XML.format(tolerance=tolerance, **EXAMPLE_MESH),
+                                                encoding="utf-8")
     blocks = stage_blocks(subject, folder, n_synergies)
     chosen = [s for s in (stages or STAGES) if s in blocks]
     body = "\n    ".join(blocks[s] for s in chosen)

@@ -69,6 +69,7 @@ def load_settings(path: str | os.PathLike[str]) -> tuple[Any, Any]:
         TrackingOptimizationSettings,
         VerificationOptimizationSettings,
     )
+    from nmsm.tools.treatment.surrogate_folder import check_surrogate_data_folder
 
     classes = {
         "TrackingOptimizationTool": TrackingOptimizationSettings,
@@ -80,6 +81,7 @@ def load_settings(path: str | os.PathLike[str]) -> tuple[Any, Any]:
     if cls is None:
         raise InputError(f"<{doc.tool}> is not a treatment optimization tool", file=path,
                          expected="<TrackingOptimizationTool>, <VerificationOptimizationTool> or <DesignOptimizationTool>")
+    check_surrogate_data_folder(doc)
     settings = cls.from_document(doc)
     solver_doc = read_settings_document(settings.optimal_control_solver_settings_file)
     return settings, OptimalControlSolverSettings.from_document(solver_doc)
