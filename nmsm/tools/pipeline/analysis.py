@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import attrs
 import numpy as np
 
+from nmsm.core.console import announce
 from nmsm.core.results import ResultsDirectory
 from nmsm.tools.pipeline.analysis_settings import TOOL, AnalysisTrial, ModelAnalysisSettings
 from nmsm.tools.pipeline.native import read_native_settings
@@ -131,6 +132,13 @@ def run_settings(settings_file: str | os.PathLike[str], *, results_directory: st
                                             if path is not None)]
     results = ResultsDirectory(settings.results_directory, inputs=inputs)
     model = load_model(settings.input_model_file)
+    measured = sum(t.inverse_dynamics_file is not None for t in settings.trials)
+    steps = [f"IK of {len(model.coordinate_names)} coordinates",
+             f"ID ({measured} trial(s) with measured moments)" if measured else "ID"]
+    if model.muscles:
+        steps.append(f"muscle analysis of {len(settings.muscle_list or model.muscles)} muscles")
+    announce("analysis", settings=settings_file, model=settings.input_model_file,
+             trials=[t.name for t in settings.trials], problem=", ".join(steps))
     done = []
     for trial in settings.trials:
         with results.task(trial.name) as stage:

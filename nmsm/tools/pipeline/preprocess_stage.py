@@ -38,6 +38,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.console import announce
 from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError
 from nmsm.io.storage import Table
@@ -102,7 +103,13 @@ def run_settings(settings_file: str | os.PathLike[str], *, results_directory: st
     settings = read_settings(settings_file)
     if results_directory is not None:
         settings = attrs.evolve(settings, results_directory=Path(results_directory))
-    run_checked(requests(settings, Path(settings_file)), keep_intermediate=False)
+    checked = requests(settings, Path(settings_file))
+    windows = sum(len(r.time_pairs) for r in checked)
+    announce("preprocess", settings=settings_file, model=settings.input_model_file,
+             trials=[t.name for t in settings.trials],
+             problem=f"{windows} time window(s) into {settings.rows_per_trial} rows each, low-pass "
+                     f"{settings.cutoff_frequency:g} Hz")
+    run_checked(checked, keep_intermediate=False)
     results = ResultsDirectory(settings.results_directory)
     results.copy_in(settings_file, f"settings_{Path(settings_file).name}")
     return results.path

@@ -20,6 +20,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.console import announce
 from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, read_storage, write_storage
@@ -69,6 +70,9 @@ def run_settings(settings_file: str | os.PathLike[str], *, results_directory: st
     motion_file = find_trial_file(settings.data_directory / "IKData", settings.trial_name)
     reference = motion_poses(model, read_storage(motion_file))
     poses = sample_poses(model, reference, settings)
+    announce("surrogate", settings=settings_file, model=settings.input_model_file, trials=[settings.trial_name],
+             problem=f"{poses.shape[0]} poses ({settings.samples_per_frame} per frame) varying "
+                     f"{len(settings.coordinate_list)} coordinates")
     time = 1e-3 * np.arange(poses.shape[0])
     table = Table(time=time, labels=tuple(model.coordinate_names), data=poses, name="surrogate poses")
     results = ResultsDirectory(settings.results_directory, inputs=[settings.input_model_file])

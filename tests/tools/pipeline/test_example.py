@@ -228,3 +228,38 @@ def test_report_in_a_browser(early, tmp_path: Path, chromium: str) -> None:
     assert facts["figure_width"] >= 400 and facts["images"] >= 2 and facts["decoded"] == facts["images"]
     assert facts["pre"] >= 1  # summaries are preformatted text
     assert loaded.screenshot[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_pipeline_stages_print_start_lines(early, tmp_path: Path, capsys) -> None:
+    """The analysis, preprocessing and surrogate stages print the tools' start line
+    (nmsm.core.console) when console output is on, and nothing when it is off."""
+    from nmsm.core.console import console_output
+    from nmsm.examples.subject_settings import PREPROCESSED_TRIAL
+    from nmsm.tools.pipeline import analysis, preprocess_stage, surrogate_stage
+
+    results = early.results
+    model = results / "jmp" / "personalized.osim"
+    surrogate = tmp_path / "surrogate.xml"
+    surrogate.write_text(f"""<NMSMPipelineDocument Version="1.5.3"><SurrogateDataTool>
+        <results_directory>{tmp_path / 'surrogate'}</results_directory>
+        <input_model_file>{model}</input_model_file>
+        <data_directory>{results / 'preprocess'}</data_directory>
+        <trial_name>{PREPROCESSED_TRIAL}</trial_name>
+        <coordinate_list>knee_angle_r</coordinate_list>
+        <samples_per_frame>2</samples_per_frame>
+        <frame_stride>25</frame_stride>
+      </SurrogateDataTool></NMSMPipelineDocument>""", encoding="utf-8")
+    surrogate_stage.run_settings(surrogate)
+    assert capsys.readouterr().out == ""  # library calls stay silent
+    with console_output():
+        analysis.run_settings(results / "analysis.xml", results_directory=tmp_path / "analysis")
+        preprocess_stage.run_settings(results / "preprocess.xml", results_directory=tmp_path / "preprocessed")
+        surrogate_stage.run_settings(surrogate, results_directory=tmp_path / "surrogate_2")
+    lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("nmsm ")]
+    assert [line.split(":")[0] for line in lines] == ["nmsm analysis", "nmsm preprocess", "nmsm surrogate"]
+    assert lines[0].startswith("nmsm analysis: settings analysis.xml; model ") and "; problem IK of " in lines[0]
+    assert "muscle analysis of 8 muscles" in lines[0]
+    assert lines[1].startswith("nmsm preprocess: settings preprocess.xml; model ") and " rows each" in lines[1]
+    assert lines[2] == (f"nmsm surrogate: settings surrogate.xml; model personalized.osim; trials {PREPROCESSED_TRIAL}; "
+                        f"problem {lines[2].split('problem ')[1]}")
+    assert " per frame) varying 1 coordinates" in lines[2]
