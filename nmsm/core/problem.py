@@ -22,6 +22,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.term import ConstraintTerm, CostTerm, SourceRef, Term, TermContext
 
 
@@ -116,6 +117,7 @@ class Solution:
     backend: str
     x_scaled: np.ndarray
     constraints: tuple[ConstraintStatus, ...] = ()
+    history: ConvergenceHistory | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.values[name]

@@ -28,6 +28,7 @@ from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxContactSurface, read_osimx
 from nmsm.io.storage import Table, read_storage
 from nmsm.plots import style
+from nmsm.plots.convergence import plot_results_convergence
 
 _FOOT = re.compile(r"_Foot_(\d+)_optimizedGroundReactions\.sto$")
 
@@ -178,4 +179,7 @@ def plot_gcp_results(results_directory: str | os.PathLike[str],
             pose = _toes_pose(osimx_files[0], osimx.associated_osim_model, surface)
             written.append(plot_stiffness(surface, out / f"Foot_{n}_stiffness.png", f"Foot {n}: spring constants",
                                           pose))
+    convergence = plot_results_convergence(folder, out, "GCP")
+    if convergence is not None:
+        written.append(convergence)
     return written

@@ -22,6 +22,7 @@ import numpy as np
 
 from nmsm.io.storage import read_storage
 from nmsm.plots import style
+from nmsm.plots.convergence import plot_results_convergence
 
 RESULTS_FILE = "jmp_results.json"
 
@@ -99,4 +100,7 @@ def plot_jmp_results(results_dir: str | os.PathLike[str], output_dir: str | os.P
     plt = _pyplot()
     paths = [_task_figure(plt, folder, task, out / f"jmp_{task['folder']}.png") for task in summary["tasks"]]
     paths.append(_summary_figure(plt, summary["tasks"], out / "jmp_summary.png"))
+    convergence = plot_results_convergence(folder, out, "JMP")
+    if convergence is not None:
+        paths.append(convergence)
     return paths

@@ -27,6 +27,7 @@ import numpy as np
 
 from nmsm.io.storage import Table, read_storage
 from nmsm.plots import style
+from nmsm.plots.convergence import plot_results_convergence
 
 #: parameter charts: osimx attribute, title, factor from the .osimx's unit (0.1 s, 0.01 s,
 #: -) to the shown one, bounds in the shown unit (MTP's design bounds,
@@ -189,4 +190,7 @@ def plot_mtp_results(results_dir: str | os.PathLike[str], output_dir: str | os.P
         chart = _parameters_figure(plt, osimx_files[0], out)
         if chart is not None:
             written.append(chart)
+    convergence = plot_results_convergence(folder, out, "MTP")
+    if convergence is not None:
+        written.append(convergence)
     return written

@@ -30,6 +30,7 @@ from nmsm.errors import InputError
 from nmsm.io.storage import Table, read_storage
 from nmsm.io.trials import find_trial_file
 from nmsm.plots import style
+from nmsm.plots.convergence import plot_results_convergence
 
 _WEIGHTS = "synergyWeights.sto"
 _COMMANDS = "_synergyCommands.sto"
@@ -222,4 +223,7 @@ def plot_ncp_results(
         written.append(plot_activation_matching(
             ncp_activations, weights.labels, commands.time, mtp_table, out / f"{trial}_activationMatching.png", trial
         ))
+    convergence = plot_results_convergence(folder, out, "NCP")
+    if convergence is not None:
+        written.append(convergence)
     return written

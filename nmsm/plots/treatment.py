@@ -37,8 +37,10 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.convergence import ConvergenceHistory
 from nmsm.io.storage import Table, read_storage, strip_load_suffix
 from nmsm.plots import style
+from nmsm.plots.convergence import plot_histories
 
 
 def _trial(folder: Path) -> str | None:
@@ -176,14 +178,8 @@ def plot_convergence(log: Path, path: Path, title: str) -> Path | None:
     table = ipopt_iterations(log)
     if table.shape[0] == 0:
         return None
-    plt, fig, (cost, violation) = style.panels(2, columns=2, size=(4.5, 3.0))
-    cost.semilogy(table[:, 0], np.abs(table[:, 1]) + 1e-300, **style.SOLUTION, label="objective")
-    cost.set_ylabel("objective (scaled)")
-    violation.semilogy(table[:, 0], table[:, 2] + 1e-300, color="C3", label="constraint violation")
-    violation.set_ylabel("largest constraint violation")
-    for ax in (cost, violation):
-        ax.set_xlabel("IPOPT iteration")
-    return style.save(plt, fig, path, title)
+    history = ConvergenceHistory(cost=table[:, 1], violation=table[:, 2])
+    return plot_histories({"IPOPT": history}, path, title, iteration_label="IPOPT iteration")
 
 
 def _tracked_folder(folder: Path) -> Path | None:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import casadi as cs
 import numpy as np
 
+from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import interrupt_after_solve
 from nmsm.core.problem import Solution
@@ -106,6 +107,7 @@ def solve_ipopt(
         backend="ipopt",
         x_scaled=x_opt,
         constraints=problem.constraint_report(x_opt),
+        history=ConvergenceHistory.from_ipopt_stats(stats),
     )
 
 

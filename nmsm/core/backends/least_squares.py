@@ -16,6 +16,7 @@ import scipy.optimize
 import scipy.sparse
 
 from nmsm.core.backends.sparse import SparseOutput
+from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.problem import Solution
 from nmsm.core.progress import with_least_squares_progress
 
@@ -82,9 +83,11 @@ def solve_least_squares(
         return J if solver == "lsmr" else J.toarray()
 
     start = time.perf_counter()
+    history = None
     if free_idx.size == 0 or n_res == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
+        fun, jac, history = record_history(fun, jac)
         if not verbose:
             fun, jac = with_least_squares_progress(problem.name, fun, jac)
         res = scipy.optimize.least_squares(
@@ -105,4 +108,37 @@ def solve_least_squares(
         wall_time=wall,
         backend="least_squares",
         x_scaled=x_opt,
+        history=history.result() if history is not None else None,
     )
+
+
+class LeastSquaresHistory:
+    """Per accepted iterate: ``sum(r**2)`` and the largest entry of the gradient ``J^T r``."""
+
+    def __init__(self) -> None:
+        self.cost: list[float] = []
+        self.optimality: list[float] = []
+
+    def result(self) -> ConvergenceHistory | None:
+        return ConvergenceHistory(self.cost, optimality=self.optimality) if self.cost else None
+
+
+def record_history(fun: Any, jac: Any) -> tuple[Any, Any, LeastSquaresHistory]:
+    """``fun`` and ``jac`` for scipy's ``least_squares`` that record a :class:`LeastSquaresHistory`: scipy evaluates the Jacobian once
+    per accepted iterate, at the point of the last residual evaluation."""
+    history = LeastSquaresHistory()
+    last = [np.full(1, np.nan)]
+
+    def recording_fun(x: np.ndarray) -> np.ndarray:
+        last[0] = r = fun(x)
+        return r
+
+    def recording_jac(x: np.ndarray) -> Any:
+        J = jac(x)
+        r = last[0]
+        history.cost.append(float(np.dot(r, r)))
+        gradient = np.asarray(J.T @ r).ravel()
+        history.optimality.append(float(np.max(np.abs(gradient), initial=0.0)))
+        return J
+
+    return recording_fun, recording_jac, history

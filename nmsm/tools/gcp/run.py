@@ -41,6 +41,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
@@ -137,6 +138,15 @@ def _group_result(feet: list[FootInputs], state: GcpState, solutions: list[Solut
     design = state.design()
     values = [foot_values(foot, design, i) for i, foot in enumerate(feet)]
     return GroupResult(feet, state, list(solutions), values, list(seconds))
+
+
+def convergence_histories(groups: Sequence[GroupResult]) -> dict[str, ConvergenceHistory | None]:
+    """Each task's iterates, named ``task_<k>`` (with several foot groups ``group_<g>_task_<k>``)."""
+    histories = {}
+    for g, group in enumerate(groups, start=1):
+        prefix = f"group_{g}_" if len(groups) > 1 else ""
+        histories.update({f"{prefix}task_{k}": s.history for k, s in enumerate(group.solutions, start=1)})
+    return histories
 
 
 def run_log(settings: GroundContactPersonalizationSettings, groups: Sequence[GroupResult],
@@ -267,4 +277,5 @@ def _write(results: ResultsDirectory, settings: GroundContactPersonalizationSett
     with task as stage:
         write_results(stage, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
         (stage / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors, note), encoding="utf-8")
+        write_convergence_table(stage / CONVERGENCE_TABLE, convergence_histories(groups))
     return errors

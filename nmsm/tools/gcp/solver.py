@@ -26,6 +26,7 @@ import numpy as np
 import scipy.optimize
 import scipy.sparse
 
+from nmsm.core.backends.least_squares import record_history
 from nmsm.core.backends.sparse import SparseOutput, dm_to_csc
 from nmsm.core.problem import OptimizationProblem, Solution
 from nmsm.core.progress import with_least_squares_progress
@@ -112,9 +113,11 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
         return lifted.jacobian(full(xf))[:, free]
 
     start = time.perf_counter()
+    history = None
     if free.size == 0:
         x_opt, status, nfev, success = x0, "nothing to optimize", 0, True
     else:
+        fun, jac, history = record_history(fun, jac)
         if not verbose:
             fun, jac = with_least_squares_progress(problem.name, fun, jac)
         with single_threaded_blas():  # LSMR's many small BLAS calls (nmsm.tools.gcp.blas_threads)
@@ -128,4 +131,5 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
     term_costs = problem.term_costs(x_opt)
     return Solution(values=problem.unpack(x_opt), cost=float(sum(term_costs.values())), term_costs=term_costs,
                     success=success, status=status, iterations=nfev, wall_time=wall,
-                    backend="least_squares (lifted foot coordinates)", x_scaled=x_opt)
+                    backend="least_squares (lifted foot coordinates)", x_scaled=x_opt,
+                    history=history.result() if history is not None else None)

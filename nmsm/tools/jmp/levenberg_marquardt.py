@@ -41,6 +41,8 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from nmsm.core.convergence import ConvergenceHistory
+
 
 class Jacobian(Protocol):
     """What the algorithm needs from a Jacobian ``J`` (m x n)."""
@@ -256,6 +258,7 @@ class LeastSquaresResult:
     converged: bool
     status: str
     gradient_norm: float
+    history: ConvergenceHistory | None = None
 
 
 @attrs.frozen(kw_only=True)
@@ -294,12 +297,16 @@ def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: An
     pg_norm = np.inf
     iteration = 0
     fixed = lower == upper
+    costs: list[float] = []
+    gradients: list[float] = []
     for iteration in range(1, tol.max_iterations + 1):
         g = jac.gradient(r)
         span = np.maximum(1e-12, 1e-12 * np.abs(x))
         active = fixed | ((x <= lower + span) & (g > 0)) | ((x >= upper - span) & (g < 0))
         free = ~active
         pg_norm = float(np.max(np.abs(g[free]), initial=0.0))
+        costs.append(cost)
+        gradients.append(pg_norm)
         if cost <= tol.ctol:
             status, converged = "cost below ctol", True
             break
@@ -346,5 +353,9 @@ def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: An
         if exhausted or evaluations >= tol.max_evaluations:
             status = "maximum evaluations reached"
             break
+    if costs and cost != costs[-1]:  # the last accepted step's point (its gradient not evaluated)
+        costs.append(cost)
+        gradients.append(float("nan"))
     return LeastSquaresResult(x=x, residuals=r, cost=cost, iterations=iteration, evaluations=evaluations,
-                              converged=converged, status=status, gradient_norm=pg_norm)
+                              converged=converged, status=status, gradient_norm=pg_norm,
+                              history=ConvergenceHistory(costs, optimality=gradients) if costs else None)

@@ -29,6 +29,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.problem import OptimizationProblem
 from nmsm.core.term import CostTerm
 from nmsm.core.threads import SOLVER_THREADS, thread_map
@@ -86,6 +87,7 @@ class JmpSolution:
     evaluations: int
     wall_time: float
     reseated_frames: int = 0
+    history: ConvergenceHistory | None = None
 
 
 class JmpProblem:
@@ -182,7 +184,7 @@ class JmpProblem:
         q, p = self.unpack(result.x)
         return JmpSolution(q=q, p=p, cost=result.cost, initial_cost=float(r0 @ r0), term_costs=self.term_costs(q, p),
                            converged=result.converged, status=result.status, iterations=result.iterations,
-                           evaluations=result.evaluations, wall_time=wall)
+                           evaluations=result.evaluations, wall_time=wall, history=result.history)
 
     def optimization_problem(self, q0: np.ndarray, p0: np.ndarray) -> OptimizationProblem:
         """The same problem as a generic :class:`OptimizationProblem` (variables ``q``

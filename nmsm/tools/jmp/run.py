@@ -38,6 +38,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.convergence import CONVERGENCE_TABLE, format_convergence_table
 from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.results import ResultsDirectory
 from nmsm.io.settings.document import read_settings_document
@@ -188,6 +189,8 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
     if not quiet:
         summarize("JMP", summary_lines(task_results, wall))
     results.write_text(REPORT_FILE, report)
+    results.write_text(CONVERGENCE_TABLE, format_convergence_table(
+        {_folder_name(r.task, k): r.solution.history for k, r in enumerate(task_results, start=1)}))
     write_summary(results, settings, summaries, wall)
     settings_copy = results.path / Path(settings.settings_file).name
     if settings_copy.resolve() != Path(settings.settings_file).resolve():

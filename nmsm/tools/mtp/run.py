@@ -34,6 +34,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import CostTerm, build_terms
@@ -94,6 +95,7 @@ class TaskOutcome:
     status: str
     iterations: int
     wall_time: float
+    history: ConvergenceHistory | None = None
 
 
 @attrs.frozen(eq=False)
@@ -256,7 +258,7 @@ def solve_tasks(
             warnings.warn(f"MTP task {k}: IPOPT ended with '{solution.status}'; using its last iterate", stacklevel=2)
         state = updated_state(state, solution.values)
         outcome = TaskOutcome(k, solution.cost, dict(solution.term_costs), solution.status, solution.iterations,
-                              solution.wall_time)
+                              solution.wall_time, solution.history)
         outcomes.append(outcome)
         _log(verbose, f"task {k}: {solution.status}, cost {solution.cost:.6g}, {solution.iterations} iterations, "
                       f"{solution.wall_time:.1f} s")
@@ -303,6 +305,9 @@ def write_results(outcome: MtpOutcome, results: ResultsDirectory, *, stopped_aft
             lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
         lines.append(f"total wall time: {outcome.wall_time:.2f} s")
         (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        histories = {"mtli": outcome.mtli.solution.history} if outcome.mtli is not None else {}
+        histories.update({f"task_{t.index}": t.history for t in outcome.tasks})
+        write_convergence_table(stage / CONVERGENCE_TABLE, histories)
 
 
 def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOutcome:

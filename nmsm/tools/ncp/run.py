@@ -25,6 +25,7 @@ from typing import Any
 
 import attrs
 
+from nmsm.core.convergence import CONVERGENCE_TABLE, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
@@ -247,6 +248,7 @@ def run_settings(
         if settings_copy.resolve() != Path(settings.settings_file).resolve():
             shutil.copy2(settings.settings_file, stage / settings_copy.name)
         (stage / LOG_FILE).write_text(_log_text(setup, solved, costs, metrics, wall), encoding="utf-8")
+        write_convergence_table(stage / CONVERGENCE_TABLE, {"ncp": solved.history})
     if plots:
         from nmsm.plots.ncp import plot_ncp_results
 

@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
+from nmsm.core.convergence import read_convergence_table
 from nmsm.io.osimx import read_osimx
 from nmsm.io.storage import read_storage
 from nmsm.tools.gcp.filtering import lowpass
@@ -53,7 +54,13 @@ def test_result_files(synthetic_run):
     for suffix in ("experimentalFootKinematics", "optimizedFootKinematics", "replacedExperimentalGroundReactions",
                    "optimizedGroundReactions"):
         assert f"foot_Foot_1_{suffix}.sto" in names
-    assert {"foot_gcp.osimx", "foot_gcpErrors.txt", "settings.xml", "commandWindowOutput.txt"} <= names
+    assert {"foot_gcp.osimx", "foot_gcpErrors.txt", "settings.xml", "commandWindowOutput.txt", "convergence.tsv"} <= names
+    histories = read_convergence_table(folder / "convergence.tsv")  # one per task, sum(r**2) per accepted iterate
+    solutions = result.groups[0].solutions
+    assert list(histories) == [f"task_{k}" for k in range(1, len(solutions) + 1)]
+    for history, solution in zip(histories.values(), solutions):
+        assert history.violation is None and np.all(np.isfinite(history.optimality))
+        assert history.cost[0] >= history.cost[-1] >= 0
     assert not [n for n in names if n.startswith(".staging")]
     surface = read_osimx(folder / "foot_gcp.osimx").contact_surfaces[0]
     assert len(surface.springs) == case.spring_constants.size
@@ -79,5 +86,5 @@ def test_plots(synthetic_run, tmp_path):
     _, result = synthetic_run
     files = plot_gcp_results(result.results_directory, tmp_path)
     assert sorted(f.name for f in files) == ["Foot_1_forces.png", "Foot_1_kinematics.png", "Foot_1_moments.png",
-                                             "Foot_1_stiffness.png"]
+                                             "Foot_1_stiffness.png", "convergence.png"]
     assert all(f.stat().st_size > 10_000 for f in files)

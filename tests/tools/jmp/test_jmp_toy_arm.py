@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from lxml import etree
 
+from nmsm.core.convergence import read_convergence_table
 from nmsm.cli import main
 from nmsm.model import load_model
 from nmsm.plots.jmp import is_jmp_results, plot_jmp_results
@@ -49,7 +50,10 @@ def test_translated_away_recovers_the_translation(shared_data, tmp_path):
     assert not list(tmp_path.glob(".staging-*"))
     assert is_jmp_results(tmp_path)
     figures = plot_jmp_results(tmp_path)
-    assert [f.name for f in figures] == ["jmp_task1_Right_Elbow.png", "jmp_summary.png"]
+    assert [f.name for f in figures] == ["jmp_task1_Right_Elbow.png", "jmp_summary.png", "convergence.png"]
+    history = read_convergence_table(tmp_path / "convergence.tsv")["task1_Right_Elbow"]
+    assert history.n_iterations >= 2 and history.cost[-1] == pytest.approx(run.tasks[0].solution.cost)
+    assert history.cost[-1] < history.cost[0] and history.violation is None
     assert all(f.stat().st_size > 10_000 for f in figures)
 
 

@@ -14,6 +14,7 @@ import warnings
 import numpy as np
 import pytest
 
+from nmsm.core.convergence import read_convergence_table
 from nmsm.io.osimx import read_osimx
 from nmsm.io.storage import read_storage
 from nmsm.plots.mtp import is_mtp_results, plot_mtp_results
@@ -95,8 +96,20 @@ def test_v3_plots(v3, tmp_path):
     written = plot_mtp_results(out, tmp_path)
     assert {p.name for p in written} == {"mtp_gait_1_moments.png", "mtp_gait_1_activations.png",
                                          "mtp_gait_1_fiber_lengths.png", "mtp_passive_moments.png",
-                                         "mtp_parameters.png"}
+                                         "mtp_parameters.png", "convergence.png"}
     assert all(p.stat().st_size > 10_000 for p in written)
+
+
+def test_v3_convergence_table(v3):
+    """MTLI's and each task's IPOPT iterates (start included) in ``convergence.tsv``."""
+    outcome, out, _, _ = v3
+    histories = read_convergence_table(out / "convergence.tsv")
+    assert list(histories) == ["mtli"] + [f"task_{t.index}" for t in outcome.tasks]
+    for task in outcome.tasks:
+        history = histories[f"task_{task.index}"]
+        assert history.n_iterations == task.iterations + 1
+        assert history.cost[-1] == pytest.approx(task.cost, rel=1e-6)
+        assert history.violation is not None and history.violation[-1] <= 1e-6
 
 
 @pytest.mark.parametrize("version", ["V1", "V2"])

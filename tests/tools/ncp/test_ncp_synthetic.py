@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from nmsm.core.convergence import CONVERGENCE_TABLE, read_convergence_table
 from nmsm.examples.synthetic_ncp import run_synthetic_ncp
 from nmsm.io.osimx import read_osimx
 from nmsm.io.storage import read_storage
@@ -51,8 +52,13 @@ def test_synthetic_outputs(tmp_path) -> None:
     assert osimx.muscles["soleus_r"].optimal_fiber_length == pytest.approx(read_osimx(case.osimx_file).muscles["soleus_r"].optimal_fiber_length)
     assert (folder / "NCPSettings.xml").is_file() and "moment RMS" in (folder / "commandWindowOutput.txt").read_text()
     figures = plot_ncp_results(folder)
-    assert {p.name for p in figures} >= {"synergyVectors.png", "trial_1_momentMatching.png", "trial_2_activationMatching.png"}
+    assert {p.name for p in figures} >= {"synergyVectors.png", "trial_1_momentMatching.png", "trial_2_activationMatching.png",
+                                         "convergence.png"}
     assert all(p.stat().st_size > 10_000 for p in figures)
+    history = read_convergence_table(folder / CONVERGENCE_TABLE)["ncp"]  # IPOPT's iterates, start included
+    assert history.n_iterations == run.solver.iterations + 1
+    assert history.cost[-1] == pytest.approx(run.solver.cost, rel=1e-6) and history.cost[-1] < history.cost[0]
+    assert history.violation is not None and history.optimality is not None
 
 
 def test_dispatcher_runs_ncp_settings(tmp_path) -> None:
