@@ -3,8 +3,8 @@
 Every back end records one :class:`ConvergenceHistory` per solve (IPOPT: objective, largest
 constraint violation ``inf_pr`` and dual infeasibility ``inf_du`` of each iterate as IPOPT
 reports them; least squares: ``sum(r**2)`` and the largest gradient entry of each accepted
-iterate, with respect to the solver's scaled variables). A tool writes the histories of its solves as one tab-separated table,
-``convergence.tsv``, one row per solve and iteration::
+iterate, with respect to the solver's scaled variables). A tool writes the histories of its
+solves as one tab-separated table, ``convergence.tsv``, one row per solve and iteration::
 
     solve	iteration	cost	constraint_violation	optimality
     task_1	0	412.3	0.0012	88.1

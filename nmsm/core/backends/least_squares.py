@@ -124,8 +124,9 @@ class LeastSquaresHistory:
 
 
 def record_history(fun: Any, jac: Any) -> tuple[Any, Any, LeastSquaresHistory]:
-    """``fun`` and ``jac`` for scipy's ``least_squares`` that record a :class:`LeastSquaresHistory`: scipy evaluates the Jacobian once
-    per accepted iterate, at the point of the last residual evaluation."""
+    """``fun`` and ``jac`` for scipy's ``least_squares`` that record a :class:`LeastSquaresHistory`:
+    scipy evaluates the Jacobian once per accepted iterate, at the point of the last residual
+    evaluation."""
     history = LeastSquaresHistory()
     last = [np.full(1, np.nan)]
 

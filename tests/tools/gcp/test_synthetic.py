@@ -54,7 +54,8 @@ def test_result_files(synthetic_run):
     for suffix in ("experimentalFootKinematics", "optimizedFootKinematics", "replacedExperimentalGroundReactions",
                    "optimizedGroundReactions"):
         assert f"foot_Foot_1_{suffix}.sto" in names
-    assert {"foot_gcp.osimx", "foot_gcpErrors.txt", "settings.xml", "commandWindowOutput.txt", "convergence.tsv"} <= names
+    assert {"foot_gcp.osimx", "foot_gcpErrors.txt", "settings.xml", "commandWindowOutput.txt",
+            "convergence.tsv"} <= names
     histories = read_convergence_table(folder / "convergence.tsv")  # one per task, sum(r**2) per accepted iterate
     solutions = result.groups[0].solutions
     assert list(histories) == [f"task_{k}" for k in range(1, len(solutions) + 1)]

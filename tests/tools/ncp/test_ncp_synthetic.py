@@ -52,8 +52,8 @@ def test_synthetic_outputs(tmp_path) -> None:
     assert osimx.muscles["soleus_r"].optimal_fiber_length == pytest.approx(read_osimx(case.osimx_file).muscles["soleus_r"].optimal_fiber_length)
     assert (folder / "NCPSettings.xml").is_file() and "moment RMS" in (folder / "commandWindowOutput.txt").read_text()
     figures = plot_ncp_results(folder)
-    assert {p.name for p in figures} >= {"synergyVectors.png", "trial_1_momentMatching.png", "trial_2_activationMatching.png",
-                                         "convergence.png"}
+    assert {p.name for p in figures} >= {"synergyVectors.png", "trial_1_momentMatching.png",
+                                         "trial_2_activationMatching.png", "convergence.png"}
     assert all(p.stat().st_size > 10_000 for p in figures)
     history = read_convergence_table(folder / CONVERGENCE_TABLE)["ncp"]  # IPOPT's iterates, start included
     assert history.n_iterations == run.solver.iterations + 1

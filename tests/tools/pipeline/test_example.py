@@ -260,6 +260,6 @@ def test_pipeline_stages_print_start_lines(early, tmp_path: Path, capsys) -> Non
     assert lines[0].startswith("nmsm analysis: settings analysis.xml; model ") and "; problem IK of " in lines[0]
     assert "muscle analysis of 8 muscles" in lines[0]
     assert lines[1].startswith("nmsm preprocess: settings preprocess.xml; model ") and " rows each" in lines[1]
-    assert lines[2] == (f"nmsm surrogate: settings surrogate.xml; model personalized.osim; trials {PREPROCESSED_TRIAL}; "
-                        f"problem {lines[2].split('problem ')[1]}")
+    assert lines[2].startswith(f"nmsm surrogate: settings surrogate.xml; model personalized.osim; "
+                               f"trials {PREPROCESSED_TRIAL}; problem ")
     assert " per frame) varying 1 coordinates" in lines[2]
