@@ -55,6 +55,18 @@ class ConvergenceHistory:
         """Number of recorded iterates (the start included)."""
         return int(self.cost.size)
 
+    def followed_by(self, later: ConvergenceHistory | None) -> ConvergenceHistory:
+        """This history and then ``later``'s (a solve restarted from another point), as one;
+        a column only one of them has is dropped."""
+        if later is None:
+            return self
+
+        def joined(a: np.ndarray | None, b: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None or b is None else np.concatenate([a, b])
+
+        return ConvergenceHistory(np.concatenate([self.cost, later.cost]), joined(self.violation, later.violation),
+                                  joined(self.optimality, later.optimality))
+
     @classmethod
     def from_ipopt_stats(cls, stats: Mapping[str, object]) -> ConvergenceHistory | None:
         """The history in CasADi's IPOPT ``stats()['iterations']``; None when it holds none."""

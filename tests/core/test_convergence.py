@@ -60,5 +60,8 @@ def test_table_round_trip_and_figure(tmp_path: Path) -> None:
     figure = plot_results_convergence(tmp_path, tmp_path / "plots", "MTP")
     assert figure == tmp_path / "plots" / "convergence.png" and figure.stat().st_size > 10_000
     assert plot_histories({"none": None}, tmp_path / "x.png", "nothing") is None
+    joined = back["task_1"].followed_by(back["task_2"])  # a restarted solve: one history
+    np.testing.assert_array_equal(joined.cost, [10.0, 1.0, 0.1, 0.1, 0.05])
+    assert joined.violation is None and joined.optimality.size == 5
     with pytest.raises(ValueError, match="violation has 2 iterations, cost 3"):
         ConvergenceHistory([1.0, 2.0, 3.0], violation=[1.0, 2.0])

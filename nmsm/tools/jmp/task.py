@@ -111,13 +111,14 @@ def solve_reseating_frames(problem: JmpProblem, model, trial: MarkerTrial, kinem
             break
         q_start = np.where(better[:, None], q_ik, solution.q)
         reseated += int(better.sum())
-        initial_cost = solution.initial_cost
+        initial_cost, history = solution.initial_cost, solution.history
         solution = problem.solve(q_start, solution.p, tolerances)
         iterations += solution.iterations
         evaluations += solution.evaluations
         wall += solution.wall_time
         solution = attrs.evolve(solution, initial_cost=initial_cost, iterations=iterations, evaluations=evaluations,
-                                wall_time=wall, reseated_frames=reseated)
+                                wall_time=wall, reseated_frames=reseated,
+                                history=history.followed_by(solution.history) if history is not None else None)
     return solution
 
 
