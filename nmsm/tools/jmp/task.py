@@ -82,44 +82,76 @@ def _warn_small_motion(model_label: str, design: TaskDesign, task: JmpTask, befo
 MAX_RESEATS = 5
 #: a frame is re-seated when inverse kinematics lowers its cost by more than this fraction
 RESEAT_GAIN = 1e-3
+#: iterations of the joint solve between two searches for frames to re-seat
+RESEAT_CHECK_ITERATIONS = 25
+
+
+def _frames_to_reseat(problem: JmpProblem, model, trial: MarkerTrial, kinematics: MarkerKinematics,
+                      design: TaskDesign, solution: JmpSolution,
+                      ik_accuracy: float | None) -> tuple[np.ndarray, int] | None:
+    """Start coordinates ``(F, n_free)`` and how many frames they re-seat: those of inverse
+    kinematics with the solution's parameters where it fits a frame better than the
+    solution's coordinates by more than :data:`RESEAT_GAIN`, the solution's elsewhere;
+    ``None`` when no frame fits better."""
+    ik = inverse_kinematics(model, trial, accuracy=ik_accuracy, kinematics=kinematics, parameters=design.parameters,
+                            parameter_values=solution.p, check_marker_units=False)
+    q_ik = ik.q[:, [ik.coordinate_names.index(n) for n in kinematics.free_names]]
+    current = problem.frame_costs(solution.q, solution.p)
+    better = problem.frame_costs(q_ik, solution.p) < (1.0 - RESEAT_GAIN) * current
+    if not better.any():
+        return None
+    return np.where(better[:, None], q_ik, solution.q), int(better.sum())
 
 
 def solve_reseating_frames(problem: JmpProblem, model, trial: MarkerTrial, kinematics: MarkerKinematics,
                            design: TaskDesign, q0: np.ndarray, p0: np.ndarray, tolerances: Tolerances,
                            ik_accuracy: float | None) -> JmpSolution:
-    """Solve the task, then re-seat frames whose coordinates sit in a worse local minimum than
-    inverse kinematics finds with the solved parameters, and solve again (at most
-    :data:`MAX_RESEATS` rounds).
+    """Solve the task, re-seating frames whose coordinates sit in a worse local minimum than
+    inverse kinematics finds with the current parameters.
 
     The joint problem moves every frame's coordinates by local steps from their start (the
     inverse kinematics of the input model): a frame that starts in another basin of its
-    inverse kinematics (a knee at the end of its range, a limb turned the other way) stays
-    there and pulls the parameters with it, while JMP's objective is the marker error left by
-    inverse kinematics of each parameter set. Inverse kinematics with the solved parameters
-    (frame after frame from the first) finds such frames; they restart from its solution.
+    inverse kinematics (a knee at the end of its range, an arm turned the other way with its
+    elbow on its limit) stays there and pulls the parameters with it, while JMP's objective is
+    the marker error left by inverse kinematics of each parameter set. The solve runs in
+    spans of :data:`RESEAT_CHECK_ITERATIONS` iterations; after each span and at convergence,
+    inverse kinematics with the current parameters (frame after frame from the first) looks
+    for such frames, which restart from its solution (at most :data:`MAX_RESEATS` rounds).
+    Checking during the solve matters: with a frame in the wrong basin the iterations crawl
+    along a valley of the marker error long before any stopping rule holds. The solve ends
+    when it converges with no frame to re-seat, or at the iteration or evaluation limit.
     """
-    solution = problem.solve(q0, p0, tolerances)
-    iterations, evaluations, wall = solution.iterations, solution.evaluations, solution.wall_time
-    reseated = 0
-    for _ in range(MAX_RESEATS):
-        ik = inverse_kinematics(model, trial, accuracy=ik_accuracy, kinematics=kinematics,
-                                parameters=design.parameters, parameter_values=solution.p, check_marker_units=False)
-        q_ik = ik.q[:, [ik.coordinate_names.index(n) for n in kinematics.free_names]]
-        current = problem.frame_costs(solution.q, solution.p)
-        better = problem.frame_costs(q_ik, solution.p) < (1.0 - RESEAT_GAIN) * current
-        if not better.any():
-            break
-        q_start = np.where(better[:, None], q_ik, solution.q)
-        reseated += int(better.sum())
-        initial_cost, history = solution.initial_cost, solution.history
-        solution = problem.solve(q_start, solution.p, tolerances)
+    iterations = evaluations = reseated = rounds = 0
+    wall = 0.0
+    initial_cost = history = None
+    q, p = q0, p0
+    while True:
+        span = min(RESEAT_CHECK_ITERATIONS, tolerances.max_iterations - iterations)
+        limits = attrs.evolve(tolerances, max_iterations=span, max_evaluations=tolerances.max_evaluations - evaluations)
+        solution = problem.solve(q, p, limits)
         iterations += solution.iterations
         evaluations += solution.evaluations
         wall += solution.wall_time
+        initial_cost = solution.initial_cost if initial_cost is None else initial_cost
         solution = attrs.evolve(solution, initial_cost=initial_cost, iterations=iterations, evaluations=evaluations,
                                 wall_time=wall, reseated_frames=reseated,
-                                history=history.followed_by(solution.history) if history is not None else None)
-    return solution
+                                history=history.followed_by(solution.history) if history is not None
+                                else solution.history)
+        history = solution.history
+        spent = iterations >= tolerances.max_iterations or evaluations >= tolerances.max_evaluations
+        if not solution.converged and solution.status != "maximum iterations reached":
+            return solution
+        found = None
+        if rounds < MAX_RESEATS:
+            found = _frames_to_reseat(problem, model, trial, kinematics, design, solution, ik_accuracy)
+        if found is not None and not spent:
+            (q, count), p = found, solution.p
+            reseated += count
+            rounds += 1
+            continue
+        if solution.converged or spent:
+            return solution
+        q, p = solution.q, solution.p
 
 
 def run_task(model_file: Path, task: JmpTask, position: int, *, allowable_error: float, tolerances: Tolerances,
