@@ -61,7 +61,9 @@ def test_tutorial_beats_the_original_output(shared_data, tmp_path, name):
     print(f"    pelvis scale: {scale_ours:.5f} vs {scale_theirs:.5f}")
     assert scale_ours == pytest.approx(scale_theirs, rel=0.01)
     assert is_jmp_results(tmp_path)
-    assert len(plot_jmp_results(tmp_path)) == len(run.tasks) + 1
+    figures = plot_jmp_results(tmp_path)
+    assert [f.name for f in figures].count("convergence.png") == 1
+    assert len(figures) == len(run.tasks) + 2  # one per task, the summary, the convergence
 
 
 def _label_permutation(start, before) -> dict[str, str]:
