@@ -16,6 +16,8 @@ def _run(args: argparse.Namespace) -> int:
     options = {}
     if args.results_directory:
         options["results_directory"] = args.results_directory
+    if args.accept_unconverged:
+        options["accept_unconverged"] = True
     outcome = run_settings_file(args.settings, **options)
     where = outcome if isinstance(outcome, Path) else getattr(outcome, "results_directory", None)
     if where is not None:  # every tool says where its results went (some print nothing else)
@@ -66,6 +68,12 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "-o", "--results-directory",
         help="write results here instead of the settings' <results_directory> (e.g. to keep a tutorial folder untouched)",
+    )
+    p.add_argument(
+        "--accept-unconverged", action="store_true",
+        help="write the results of a solve that did not reach its stopping criterion where results go, each file "
+             "stamped UNCONVERGED (default: its last iterate and a diagnosis go into RESULTS/last_iterate/ and nmsm "
+             "exits with status 1)",
     )
     p.set_defaults(func=_run)
 

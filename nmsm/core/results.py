@@ -47,6 +47,7 @@ import warnings
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
+from nmsm.core.unconverged import stamp_unconverged
 from nmsm.errors import InputError
 from nmsm.io.output_file import move_into_place
 
@@ -160,12 +161,15 @@ class ResultsDirectory:
         self._inputs.update(Path(p).resolve() for p in paths)
 
     @contextlib.contextmanager
-    def task(self, name: str = "task", *, record: str | None = None, part_of_run: bool = True) -> Iterator[Path]:
+    def task(self, name: str = "task", *, record: str | None = None, part_of_run: bool = True,
+             unconverged: str | None = None) -> Iterator[Path]:
         """Stage a task's files; move them into the results folder when the block ends normally.
 
         ``record``: list the files in that record, retiring those of the earlier record that
         were not written again (module docstring). ``part_of_run`` False: the run's record
         (``ResultsDirectory(record=...)``) is neither begun nor extended by this task.
+        ``unconverged``: the note of accepted unconverged results; every staged file is
+        stamped with it before the move (:func:`nmsm.core.unconverged.stamp_unconverged`).
         """
         stage = Path(tempfile.mkdtemp(prefix=f".staging-{_safe(name)}-", dir=self.ensure()))
         try:
@@ -175,6 +179,8 @@ class ResultsDirectory:
             self.remove_if_unused()
             raise
         try:
+            if unconverged is not None:
+                stamp_unconverged(stage, unconverged)
             written = self._commit(stage, part_of_run)
         except BaseException:
             self.remove_if_unused()
@@ -286,9 +292,9 @@ class ResultsDirectory:
         _write_record(target / _RECORD.format(_safe(record)), files)
         return files
 
-    def write_text(self, relative: str, text: str) -> Path:
+    def write_text(self, relative: str, text: str, *, unconverged: str | None = None) -> Path:
         """Write one text file atomically (outside a task)."""
-        with self.task(Path(relative).stem) as stage:
+        with self.task(Path(relative).stem, unconverged=unconverged) as stage:
             target = stage / relative
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(text, encoding="utf-8")

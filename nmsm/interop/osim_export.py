@@ -34,6 +34,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
+from nmsm.io.xml_input import xml_parser
 from nmsm.io.osimx import (
     OsimxContactSurface,
     OsimxModel,
@@ -223,8 +224,7 @@ def export_osimx(osimx_path: str | os.PathLike[str], output: str | os.PathLike[s
         if changed:
             updated.append(name)
     writer.write(output)
-    parser = etree.XMLParser(remove_comments=False)
-    tree = etree.parse(str(output), parser)
+    tree = etree.parse(str(output), xml_parser(huge_tree=True, remove_comments=False))
     model = _model_element(tree.getroot(), output)
     _activation_constants(model, osimx)
     notes = []

@@ -55,7 +55,7 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.names import close_matches
 from nmsm.io.numbers import significant15
-from nmsm.io.xml_input import element_text, parse_xml_file, xml_input_error
+from nmsm.io.xml_input import element_text, parse_xml_file, refuse_entities, xml_input_error, xml_parser
 
 #: version written when the model has none
 OSIMX_VERSION = "1.5.3"
@@ -515,7 +515,7 @@ def _describe(element: etree._Element) -> str:
 
 
 def _serialize(element: etree._Element) -> str:
-    copy = etree.fromstring(etree.tostring(element))
+    copy = etree.fromstring(etree.tostring(element), xml_parser())
     copy.tail = None
     return etree.tostring(copy, encoding="unicode")
 
@@ -530,11 +530,10 @@ def read_osimx(path: str | os.PathLike[str]) -> OsimxModel:
 def parse_osimx(text: str | bytes, *, source: Path | None = None) -> OsimxModel:
     """Parse ``.osimx`` text (see :func:`read_osimx`)."""
     try:
-        root = etree.fromstring(
-            text.encode() if isinstance(text, str) else text, etree.XMLParser(remove_blank_text=True)
-        )
+        root = etree.fromstring(text.encode() if isinstance(text, str) else text, xml_parser(remove_blank_text=True))
     except etree.XMLSyntaxError as exc:
         raise xml_input_error(exc, source) from exc
+    refuse_entities(root, source, ".osimx file")
     return _Reader(source).read(root)
 
 
@@ -643,7 +642,7 @@ def _add(parent: etree._Element, tag: str, text: str, *, comment: bool = True) -
 
 def _add_extra(parent: etree._Element, extra: Iterable[str]) -> None:
     for item in extra:
-        parent.append(etree.fromstring(item))
+        parent.append(etree.fromstring(item, xml_parser()))
 
 
 def _bool(value: bool) -> str:

@@ -4,6 +4,12 @@ A file saved by Notepad as "ANSI" (Windows-1252) that declares UTF-8, or declare
 has bytes such as ``ü`` that are not UTF-8: libxml2 reports ``ERR_INVALID_ENCODING``, and
 the user is told to save it as UTF-8 or to name its encoding (docs/install.md, "Files from
 Windows"). Every other syntax error is "malformed XML" at its line.
+
+Every XML file nmsm reads is parsed by :func:`xml_parser`: entities are never substituted,
+no DTD is loaded and nothing is fetched from the network, and a file that declares entities
+(``<!DOCTYPE r [<!ENTITY ...>]>``: external ones read other files or URLs, nested internal
+ones expand without bound) is refused by :func:`refuse_entities` naming the file. OpenSim
+and nmsm files declare none.
 """
 
 from __future__ import annotations
@@ -17,6 +23,49 @@ from nmsm.errors import InputError
 
 #: libxml2's code for bytes that are not valid in the file's (declared or default UTF-8) encoding
 ENCODING_ERROR = etree.ErrorTypes.ERR_INVALID_ENCODING
+
+
+def xml_parser(*, huge_tree: bool = False, **options: bool) -> etree.XMLParser:
+    """An lxml parser that reads only the given bytes (nested entity declarations that would
+    expand beyond libxml2's amplification limit are a syntax error): no entity substitution, no DTD loading,
+    no network access. ``huge_tree`` only for OpenSim models (text nodes over 10 MB);
+    ``options``: other :class:`lxml.etree.XMLParser` flags (``remove_blank_text``, ...)."""
+    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=huge_tree, **options)
+
+
+def refuse_entities(node: etree._Element | etree._ElementTree, file: str | os.PathLike[str] | None,
+                    what: str = "XML file") -> None:
+    """Raise :class:`InputError` naming ``file`` when the document of ``node`` declares
+    entities, names an external DTD (``<!DOCTYPE r SYSTEM "...">``, never loaded) or holds an
+    entity reference left unexpanded."""
+    tree = node if isinstance(node, etree._ElementTree) else node.getroottree()
+    dtd = tree.docinfo.internalDTD
+    names = [entity.name for entity in dtd.iterentities()] if dtd is not None else []
+    if tree.docinfo.system_url or tree.docinfo.public_id:
+        raise InputError(
+            f"the {what} names an external DTD ({tree.docinfo.system_url or tree.docinfo.public_id}) in its "
+            "<!DOCTYPE>; nmsm reads no DTD", file=file, line=1, element="<!DOCTYPE>",
+            expected="a file without a <!DOCTYPE> (OpenSim and nmsm files have none)")
+    names += sorted({entity.name for entity in tree.getroot().iter(etree.Entity)} - set(names))
+    if names:
+        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+        raise InputError(
+            f"the {what} declares XML entities ({shown}) in its <!DOCTYPE>; nmsm does not expand entities "
+            "(they can read other files or network addresses, or grow without bound)",
+            file=file, line=1, element="<!DOCTYPE>",
+            expected="a file without <!ENTITY> declarations: write their text in place")
+
+
+def parse_xml_bytes(data: bytes, file: str | os.PathLike[str] | None, *, what: str = "XML file",
+                    huge_tree: bool = False, **options: bool) -> etree._Element:
+    """The root element of the XML ``data`` read from ``file`` (:func:`xml_parser`); malformed
+    XML or declared entities -> :class:`InputError` naming ``file``."""
+    try:
+        root = etree.fromstring(data, xml_parser(huge_tree=huge_tree, **options))
+    except etree.XMLSyntaxError as exc:
+        raise xml_input_error(exc, file) from None
+    refuse_entities(root, file, what)
+    return root
 
 
 def xml_input_error(exc: etree.XMLSyntaxError, file: str | os.PathLike[str] | None) -> InputError:
@@ -39,17 +88,15 @@ def parse_xml_file(path: str | os.PathLike[str], *, what: str = "XML file",
     The bytes are read first and parsed from memory: lxml parsing a file by name reports bad
     bytes as an ``OSError`` ("Invalid bytes in character encoding") with no line, while from
     memory they are an ``XMLSyntaxError`` with its line. Unreadable file, bad encoding or
-    malformed XML -> :class:`InputError` naming the file (``what``: "settings file", ...).
+    malformed XML or declared entities -> :class:`InputError` naming the file (``what``:
+    "settings file", ...).
     """
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
         raise InputError(f"cannot read {what}: {exc.strerror or exc}", file=path,
                          expected=f"a readable {what}") from exc
-    try:
-        return etree.fromstring(data, etree.XMLParser(remove_blank_text=remove_blank_text))
-    except etree.XMLSyntaxError as exc:
-        raise xml_input_error(exc, path) from None
+    return parse_xml_bytes(data, path, what=what, remove_blank_text=remove_blank_text)
 
 
 def element_text(element: etree._Element | None) -> str:

@@ -24,6 +24,7 @@ from scipy.interpolate import CubicSpline
 
 from nmsm.errors import InputError
 from nmsm.io.storage import Table, read_storage
+from nmsm.io.xml_input import refuse_entities, xml_parser
 
 
 @attrs.frozen
@@ -52,9 +53,10 @@ def read_external_loads(path: str | Path) -> ExternalLoads:
     """Read an OpenSim ExternalLoads XML file (data file resolved relative to it)."""
     path = Path(path)
     try:
-        root = etree.parse(str(path)).getroot()
+        root = etree.parse(str(path), xml_parser()).getroot()
     except (OSError, etree.XMLSyntaxError) as exc:
         raise InputError(f"cannot read external loads ({exc})", file=path, expected="an OpenSim ExternalLoads XML file") from None
+    refuse_entities(root, path, "external loads file")
     loads = root if root.tag == "ExternalLoads" else root.find("ExternalLoads")
     if loads is None:
         raise InputError("no <ExternalLoads> element", file=path, expected="an OpenSim ExternalLoads XML file")

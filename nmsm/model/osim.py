@@ -16,7 +16,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from nmsm.errors import ModelError
+from nmsm.errors import InputError, ModelError
+from nmsm.io.xml_input import refuse_entities, xml_parser
 from nmsm.model.components import Model
 from nmsm.model.parse_model import parse_model_document
 
@@ -33,13 +34,16 @@ def cache_dir() -> Path:
 
 def read_xml(path: str | Path) -> etree._ElementTree:
     """The XML tree of ``path`` (comments and layout kept); ModelError if it is not XML."""
-    parser = etree.XMLParser(remove_blank_text=False, huge_tree=True)
     try:
-        tree = etree.parse(str(path), parser)
+        tree = etree.parse(str(path), xml_parser(huge_tree=True, remove_blank_text=False))
     except OSError as exc:
         raise ModelError(f"cannot read the model file ({exc})", file=path) from None
     except etree.XMLSyntaxError as exc:
         raise ModelError(f"not a valid XML file ({exc})", file=path, expected="an OpenSim .osim file") from None
+    try:
+        refuse_entities(tree, path, "model file")
+    except InputError as exc:
+        raise ModelError(exc.detail, file=path, line=1, element="<!DOCTYPE>", expected=exc.expected) from None
     declared = tree.docinfo.encoding or "UTF-8"
     if not ascii_compatible(declared):
         raise ModelError(

@@ -26,6 +26,13 @@ TOOL_RUNNERS: dict[str, str] = {
 }
 
 
+#: tools that solve an optimization: the ones ``accept_unconverged`` applies to
+SOLVING_TOOLS: frozenset[str] = frozenset({
+    "JointModelPersonalizationTool", "MuscleTendonPersonalizationTool", "NeuralControlPersonalizationTool",
+    "GroundContactPersonalizationTool", "TrackingOptimizationTool", "VerificationOptimizationTool",
+    "DesignOptimizationTool"})
+
+
 def tool_element_name(settings_file: str | Path) -> str:
     """The tool element of a settings file (old schemas upgraded first)."""
     from nmsm.io.settings.document import read_settings_document
@@ -57,6 +64,8 @@ def run_settings_file(settings_file: str | Path, **options: Any) -> Any:
             file=settings_file,
             expected="one of " + ", ".join(f"<{t}>" for t in TOOL_RUNNERS),
         )
+    if not options.get("accept_unconverged", True) or (tag not in SOLVING_TOOLS and tag != "PipelineTool"):
+        options.pop("accept_unconverged", None)  # a tool without a solve has nothing to accept
     module_name, func_name = target.split(":")
     try:
         module = importlib.import_module(module_name)

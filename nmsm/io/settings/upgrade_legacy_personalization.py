@@ -12,7 +12,7 @@ from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import TOOL_ELEMENTS, elements
 from nmsm.io.settings.upgrade import Upgrader, child_of
-from nmsm.io.xml_input import element_text, set_element_text
+from nmsm.io.xml_input import element_text, refuse_entities, set_element_text, xml_parser
 
 #: 2021 JMP option names -> current
 JMP_OPTION_NAMES = {
@@ -128,7 +128,8 @@ def _jmp_ik_settings(up: Upgrader, task: etree._Element, ik: etree._Element) -> 
         return
     try:
         path = resolve_path(text, settings_file=up.path, line=ik.sourceline, element="ik_settings_file", kind="file")
-        root = etree.parse(str(path)).getroot()
+        root = etree.parse(str(path), xml_parser()).getroot()
+        refuse_entities(root, path, "IK settings file")
     except (InputError, OSError, etree.XMLSyntaxError) as exc:
         up.drop(ik, f"the IK settings could not be read ({exc}); set <time_range> and <marker_names> by hand")
         return
@@ -318,7 +319,9 @@ def _read_model(up: Upgrader, tool: etree._Element) -> etree._Element | None:
         path = resolve_path(
             text, settings_file=up.path, line=element.sourceline, element="input_model_file", kind="file"
         )
-        return etree.parse(str(path)).getroot()
+        root = etree.parse(str(path), xml_parser(huge_tree=True)).getroot()
+        refuse_entities(root, path, "model file")
+        return root
     except (InputError, OSError, etree.XMLSyntaxError) as exc:
         up.note(element, f"model not readable to find the hindfoot body: {exc}")
         return None

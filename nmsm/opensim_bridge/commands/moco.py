@@ -13,12 +13,13 @@ import math
 import os
 import re
 import time
-import xml.etree.ElementTree as ET
 from typing import Any
 
 import numpy as np
 import opensim as osim
+from lxml import etree
 
+from nmsm.io.xml_input import xml_parser
 from nmsm.opensim_bridge.commands import command
 
 #: the anchors' coordinate bounds (rad, m), keyed by state path
@@ -48,7 +49,7 @@ def _components(model: Any, cls: Any) -> list[Any]:
 def _torque_model(model_file: str, workdir: str, reserve: float, residual: float) -> osim.ModelProcessor:
     """The anchors' torque-driven model: muscles removed (XML edit: they sit under
     ``<components>``), a CoordinateActuator ``tau_<coord>`` on every coordinate but lumbar."""
-    tree = ET.parse(model_file)
+    tree = etree.parse(model_file, xml_parser(huge_tree=True))
     for parent in tree.getroot().iter():
         for child in list(parent):
             if child.tag == "DeGrooteFregly2016Muscle":

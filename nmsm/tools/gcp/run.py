@@ -28,7 +28,12 @@ Options:
 ``update_motion``      re-run IK with the modeled foot markers (default True);
 ``verbose``            print each solver iteration;
 ``keep_finished_on_stop`` default True (the pipeline, which discards a stopped stage's
-                       folder, passes False).
+                       folder, passes False);
+``accept_unconverged`` write the results although a task's solve stopped before its
+                       tolerances (at ``max_iterations`` residual evaluations), stamped as
+                       unconverged; by default such a run stops after that task and writes
+                       its results into ``<results>/last_iterate/`` with ``diagnosis.txt``
+                       and raises :class:`~nmsm.errors.SolverError` (:mod:`nmsm.core.unconverged`).
 """
 
 from __future__ import annotations
@@ -46,6 +51,7 @@ from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import build_terms
+from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, read_osimx
 from nmsm.io.settings.document import read_settings_document
@@ -110,9 +116,11 @@ def task_terms(settings: GroundContactPersonalizationSettings) -> list[list[Any]
 
 def optimize_group(settings: GroundContactPersonalizationSettings, feet: list[FootInputs], *,
                    max_iterations: int | None = None, verbose: bool = False,
-                   on_task: Callable[[GroupResult], None] | None = None) -> GroupResult:
+                   on_task: Callable[[GroupResult], None] | None = None,
+                   stop_unconverged: bool = False) -> GroupResult:
     """Initialize and run every task for ``feet`` optimized together; ``on_task`` gets the
-    group as it stands after each finished task."""
+    group as it stands after each finished task; ``stop_unconverged``: stop after the first
+    task whose solve did not converge."""
     check_equal_spring_counts(feet, settings.settings_file)
     terms_per_task = task_terms(settings)
     state = GcpState.initial(settings, feet)
@@ -130,7 +138,19 @@ def optimize_group(settings: GroundContactPersonalizationSettings, feet: list[Fo
         seconds.append(time.perf_counter() - start)
         if on_task is not None:
             on_task(_group_result(feet, state, solutions, seconds))
+        if stop_unconverged and not solution.success:
+            break
     return _group_result(feet, state, solutions, seconds)
+
+
+def unconverged_tasks(groups: Sequence[GroupResult]) -> list[str]:
+    """A description of each task whose solve did not converge."""
+    out = []
+    for g, group in enumerate(groups, start=1):
+        where = f" of foot group {g}" if len(groups) > 1 else ""
+        out += [f"GCP task {k}{where}: {solution.status} ({solution.iterations} evaluations)"
+                for k, solution in enumerate(group.solutions, start=1) if not solution.success]
+    return out
 
 
 def _group_result(feet: list[FootInputs], state: GcpState, solutions: list[Solution],
@@ -193,7 +213,7 @@ def load_feet(settings: GroundContactPersonalizationSettings, *, spring_location
 def run_settings(path: str | Path, *, results_directory: str | Path | None = None, feet: str = "separately",
                  spring_locations: str | Path | None = None, max_iterations: int | None = None,
                  update_motion: bool = True, verbose: bool = False,
-                 keep_finished_on_stop: bool = True) -> GcpRunResult:
+                 keep_finished_on_stop: bool = True, accept_unconverged: bool = False) -> GcpRunResult:
     """Run GCP from a settings file (module docstring)."""
     start = time.perf_counter()
     if feet not in FEET_MODES:
@@ -228,7 +248,9 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
         for group in groups_inputs:
             latest.clear()
             groups.append(optimize_group(settings, group, max_iterations=max_iterations, verbose=verbose,
-                                         on_task=remember))
+                                         on_task=remember, stop_unconverged=not accept_unconverged))
+            if unconverged_tasks(groups) and not accept_unconverged:
+                break
     except KeyboardInterrupt:
         finished = groups + latest
         if keep_finished_on_stop and len(finished) == len(groups_inputs):  # every foot has a finished task
@@ -240,7 +262,12 @@ def run_settings(path: str | Path, *, results_directory: str | Path | None = Non
             print(f"nmsm: GCP stopped during task {k + 1}{where}; the results after task {k} are in "
                   f"{results.path / STOPPED_FOLDER.format(k=k)}", file=sys.stderr)
         raise
-    errors = _write(results, settings, groups, casadi_model, motion, grf, osimx, update_motion)
+    failures = unconverged_tasks(groups)
+    stamp = settle(results, path, failures, accept=accept_unconverged,
+                   write=lambda folder: _write_files(folder, settings, groups, casadi_model, motion, grf, osimx,
+                                                     update_motion, _errors(groups)),
+                   diagnosis=lambda note: _diagnosis(note, settings, groups, len(groups_inputs)))
+    errors = _write(results, settings, groups, casadi_model, motion, grf, osimx, update_motion, unconverged=stamp)
     results.copy_in(path)
     outcome = GcpRunResult(settings, groups, results.path, errors, time.perf_counter() - start)
     summarize("GCP", summary_lines(outcome))
@@ -268,14 +295,38 @@ def summary_lines(outcome: GcpRunResult) -> list[str]:
 
 def _write(results: ResultsDirectory, settings: GroundContactPersonalizationSettings, groups: list[GroupResult],
            casadi_model: CasadiModel, motion: Any, grf: Any, osimx: OsimxModel | None, update_motion: bool, *,
-           stopped_after: int | None = None, note: str | None = None) -> dict[int, dict[str, float]]:
+           stopped_after: int | None = None, note: str | None = None,
+           unconverged: str | None = None) -> dict[int, dict[str, float]]:
     """Write the groups' results as one task (``stopped_after``: a stopped run's results
-    after that task, :meth:`ResultsDirectory.stopped_task`); returns the error table."""
-    errors = {foot.index: report.rms_errors(foot, values)
-              for group in groups for foot, values in zip(group.feet, group.values)}
-    task = results.task("gcp") if stopped_after is None else results.stopped_task(stopped_after)
+    after that task, :meth:`ResultsDirectory.stopped_task`; ``unconverged``: the stamp of
+    accepted unconverged results); returns the error table."""
+    errors = _errors(groups)
+    task = results.task("gcp", unconverged=unconverged) if stopped_after is None else results.stopped_task(stopped_after)
     with task as stage:
-        write_results(stage, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
-        (stage / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors, note), encoding="utf-8")
-        write_convergence_table(stage / CONVERGENCE_TABLE, convergence_histories(groups))
+        _write_files(stage, settings, groups, casadi_model, motion, grf, osimx, update_motion, errors, note)
     return errors
+
+
+def _diagnosis(note: str, settings: GroundContactPersonalizationSettings, groups: Sequence[GroupResult],
+               n_groups: int) -> str:
+    """``diagnosis.txt`` of an unconverged run: hints, then the run's log."""
+    solutions = [s for group in groups for s in group.solutions]
+    hints = dict.fromkeys(h for s in solutions if not s.success for h in status_hints(s.status, "<max_iterations>"))
+    text = run_log(settings, groups, _errors(groups))
+    if len(solutions) < len(settings.tasks) * n_groups:
+        text += "\nlater tasks or foot groups not run: they would start from this unconverged result"
+    return diagnosis_text(note, list(hints), text)
+
+
+def _errors(groups: Sequence[GroupResult]) -> dict[int, dict[str, float]]:
+    return {foot.index: report.rms_errors(foot, values)
+            for group in groups for foot, values in zip(group.feet, group.values)}
+
+
+def _write_files(folder: Path, settings: GroundContactPersonalizationSettings, groups: list[GroupResult],
+                 casadi_model: CasadiModel, motion: Any, grf: Any, osimx: OsimxModel | None, update_motion: bool,
+                 errors: dict[int, dict[str, float]], note: str | None = None) -> None:
+    """The result files and ``commandWindowOutput.txt`` of ``groups`` in ``folder``."""
+    write_results(folder, settings, groups, casadi_model, motion, grf, osimx, errors, update_motion=update_motion)
+    (folder / "commandWindowOutput.txt").write_text(run_log(settings, groups, errors, note), encoding="utf-8")
+    write_convergence_table(folder / CONVERGENCE_TABLE, convergence_histories(groups))

@@ -24,6 +24,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
+from nmsm.io.xml_input import refuse_entities, xml_parser
 
 _UNSET = {"", "unassigned"}
 
@@ -84,11 +85,13 @@ def _bool(path: Path, elem: etree._Element, text: str | None) -> bool:
 
 def _parse(path: Path) -> etree._Element:
     try:
-        return etree.parse(str(path)).getroot()
+        root = etree.parse(str(path), xml_parser()).getroot()
     except OSError as exc:
         raise InputError(f"cannot read the IK settings file ({exc})", file=path) from None
     except etree.XMLSyntaxError as exc:
         raise InputError(f"malformed XML: {exc.msg}", file=path, line=exc.lineno, expected="well-formed XML") from None
+    refuse_entities(root, path, "IK settings file")
+    return root
 
 
 def _find(root: etree._Element, tag: str) -> etree._Element | None:

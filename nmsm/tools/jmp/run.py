@@ -30,9 +30,12 @@ differentiates exactly, so it has no counterpart (the log says so).
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
+import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +44,7 @@ import attrs
 from nmsm.core.convergence import CONVERGENCE_TABLE, format_convergence_table
 from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.results import ResultsDirectory
+from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
 from nmsm.io.storage import write_storage
@@ -123,11 +127,16 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
                  function_tolerance: float | None = None, step_tolerance: float | None = None,
                  optimality_tolerance: float | None = None, max_function_evaluations: int | None = None,
                  max_iterations: int = DEFAULT_MAX_ITERATIONS, accuracy: float | None = None,
-                 plots: bool = False, quiet: bool = False) -> JmpRun:
+                 plots: bool = False, quiet: bool = False, accept_unconverged: bool = False) -> JmpRun:
     """Run JMP as the settings file ``path`` says (see module docstring).
 
     Keyword options override the settings (``results_directory``, the optimizer tolerances,
     ``accuracy``); ``plots=True`` also draws the figures; ``quiet`` silences the log on stdout.
+    A task whose optimization stopped before its tolerances (at ``max_function_evaluations``
+    or ``max_iterations``) ends the run: its files and model go into
+    ``<results>/last_iterate/`` with ``diagnosis.txt`` and :class:`~nmsm.errors.SolverError`
+    is raised, unless ``accept_unconverged`` (then the results of that task and every later
+    file are stamped as unconverged; :mod:`nmsm.core.unconverged`).
     """
     start = time.perf_counter()
     settings = read_settings(path)
@@ -165,15 +174,25 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
     blocks: list[str] = []
     summaries: list[dict[str, Any]] = []
     final_name = settings.output_model_path.name
+    failures: list[str] = []
+    stamp: str | None = None
     for position, task in enumerate(settings.tasks, start=1):
         last = position == len(settings.tasks)
         folder = _folder_name(task, position)
-        with results.task(folder) as stage:
-            relative = Path(final_name) if last else Path(folder) / f"{Path(final_name).stem}_after_{folder}.osim"
+        relative = Path(final_name) if last else Path(folder) / f"{Path(final_name).stem}_after_{folder}.osim"
+        with _work_folder(results) as work:
             result = run_task(model_file, task, position, allowable_error=settings.allowable_error,
-                              tolerances=tolerances, ik_accuracy=settings.accuracy, output=stage / relative,
+                              tolerances=tolerances, ik_accuracy=settings.accuracy, output=work / relative,
                               settings_file=str(settings.settings_file), log=log)
-            _task_files(stage, folder, result)
+            _task_files(work, folder, result)
+            if not result.solution.converged:
+                failures.append(f"{result.label}: {result.solution.status} after {result.solution.iterations} "
+                                f"iterations, {result.solution.evaluations} evaluations")
+                stamp = settle(results, settings.settings_file, failures, accept=accept_unconverged,
+                               write=lambda target: shutil.copytree(work, target, dirs_exist_ok=True),
+                               diagnosis=lambda note: _diagnosis(note, result, folder, len(settings.tasks) - position))
+            with results.task(folder, unconverged=stamp) as stage:
+                shutil.copytree(work, stage, dirs_exist_ok=True)
         result = attrs.evolve(result, output=results.path / relative)
         model_file = result.output
         text, data = _task_summary(result, folder)
@@ -188,14 +207,15 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
     log_lines.append(report)
     if not quiet:
         summarize("JMP", summary_lines(task_results, wall))
-    results.write_text(REPORT_FILE, report)
+    results.write_text(REPORT_FILE, report, unconverged=stamp)
     results.write_text(CONVERGENCE_TABLE, format_convergence_table(
-        {_folder_name(r.task, k): r.solution.history for k, r in enumerate(task_results, start=1)}))
-    write_summary(results, settings, summaries, wall)
+        {_folder_name(r.task, k): r.solution.history for k, r in enumerate(task_results, start=1)}),
+        unconverged=stamp)
+    write_summary(results, settings, summaries, wall, unconverged=stamp)
     settings_copy = results.path / Path(settings.settings_file).name
     if settings_copy.resolve() != Path(settings.settings_file).resolve():
         results.copy_in(settings.settings_file)
-    results.write_text(LOG_FILE, "\n".join(log_lines) + "\n")
+    results.write_text(LOG_FILE, "\n".join(log_lines) + "\n", unconverged=stamp)
     if plots:
         from nmsm.plots.jmp import plot_jmp_results
 
@@ -220,9 +240,32 @@ def summary_lines(tasks: Sequence[TaskResult], wall_time: float) -> list[str]:
     return lines
 
 
+@contextlib.contextmanager
+def _work_folder(results: ResultsDirectory) -> Iterator[Path]:
+    """A hidden folder inside the results folder where a task writes before its files are
+    committed (or kept as the last iterate); removed however the block ends."""
+    work = Path(tempfile.mkdtemp(prefix=".jmp-task-", dir=results.ensure()))
+    try:
+        yield work
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        results.remove_if_unused()
+        raise
+    shutil.rmtree(work, ignore_errors=True)
+
+
+def _diagnosis(note: str, result: TaskResult, folder: str, not_run: int) -> str:
+    """``diagnosis.txt`` of an unconverged task: hints, then the task's report."""
+    hints = status_hints(result.solution.status, "<max_function_evaluations>")
+    text, _ = _task_summary(result, folder)
+    if not_run:
+        text += f"\n{not_run} later task(s) not run: they would start from this unconverged model"
+    return diagnosis_text(note, hints, text)
+
+
 def write_summary(results: ResultsDirectory, settings: JointModelPersonalizationSettings,
-                  tasks: Sequence[dict[str, Any]], wall_time: float) -> None:
-    with results.task("summary") as stage:
+                  tasks: Sequence[dict[str, Any]], wall_time: float, *, unconverged: str | None = None) -> None:
+    with results.task("summary", unconverged=unconverged) as stage:
         write_json(stage / RESULTS_FILE, {
             "tool": "JointModelPersonalization", "settings": str(settings.settings_file),
             "input_model": str(settings.input_model_file), "output_model": settings.output_model_path.name,

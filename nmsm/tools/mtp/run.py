@@ -18,7 +18,12 @@ earlier complete run's files stay at the top; the next run retires the folder in
 ``print_level`` (IPOPT, default 0), ``max_iterations`` (override), ``tolerance`` (IPOPT
 ``tol``, default 1e-6), ``emg_spline_stride`` (default 4), ``verbose`` (progress lines),
 ``keep_finished_on_stop`` (default true; the pipeline, which discards a stopped stage's
-folder, passes false).
+folder, passes false), ``accept_unconverged`` (default false).
+
+A task (or MTLI) whose IPOPT solve did not converge stops the run: the results after that
+task go into ``<results>/last_iterate/`` with ``diagnosis.txt``, the later tasks do not run,
+and :class:`~nmsm.errors.SolverError` is raised (:mod:`nmsm.core.unconverged`); with
+``accept_unconverged`` every task runs and the results are written, stamped as unconverged.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_c
 from nmsm.core.console import announce, summarize
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.term import CostTerm, build_terms
+from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.errors import InputError, SolverError
 from nmsm.io.layout import trial_table_folders
 from nmsm.io.osimx import OsimxModel, read_osimx
@@ -96,6 +102,7 @@ class TaskOutcome:
     iterations: int
     wall_time: float
     history: ConvergenceHistory | None = None
+    converged: bool = True
 
 
 @attrs.frozen(eq=False)
@@ -237,8 +244,10 @@ def solve_tasks(
     tolerance: float = 1e-6,
     verbose: bool = False,
     on_task: Any = None,
+    stop_unconverged: bool = False,
 ) -> tuple[MtpData, MtpState, list[TaskOutcome]]:
-    """Run every task in order from ``state`` (default: the original's initial values)."""
+    """Run every task in order from ``state`` (default: the original's initial values);
+    ``stop_unconverged``: stop after the first task whose solve did not converge."""
     state = state or MtpState.initial(data)
     initial_lengths = initial_fiber_lengths(data)
     outcomes = []
@@ -254,17 +263,17 @@ def solve_tasks(
         )
         if not all(np.all(np.isfinite(v)) for v in solution.values.values()):
             raise SolverError(f"MTP task {k} returned non-finite values ({solution.status})")
-        if not solution.success:
-            warnings.warn(f"MTP task {k}: IPOPT ended with '{solution.status}'; using its last iterate", stacklevel=2)
         state = updated_state(state, solution.values)
         outcome = TaskOutcome(k, solution.cost, dict(solution.term_costs), solution.status, solution.iterations,
-                              solution.wall_time, solution.history)
+                              solution.wall_time, solution.history, bool(solution.success))
         outcomes.append(outcome)
         _log(verbose, f"task {k}: {solution.status}, cost {solution.cost:.6g}, {solution.iterations} iterations, "
                       f"{solution.wall_time:.1f} s")
         if on_task is not None:
             on_task(k, data, state, outcome)
         data, state = absorb_length_scales(data, state)
+        if stop_unconverged and not outcome.converged:
+            break
     return data, state, outcomes
 
 
@@ -275,39 +284,45 @@ def output_osimx_name(setup: MtpSetup) -> str:
 
 
 def write_results(outcome: MtpOutcome, results: ResultsDirectory, *, stopped_after: int | None = None,
-                  note: str | None = None) -> None:
+                  note: str | None = None, unconverged: str | None = None) -> None:
     """Write ``outcome`` into ``results`` as one task (``stopped_after``: a stopped run's
     results after that task, :meth:`ResultsDirectory.stopped_task`); ``note``: a first line
-    of ``mtpSummary.txt``."""
+    of ``mtpSummary.txt``; ``unconverged``: the stamp of accepted unconverged results."""
+    task = (results.task("mtp_results", unconverged=unconverged) if stopped_after is None
+            else results.stopped_task(stopped_after))
+    with task as stage:
+        write_result_files(stage, outcome, note)
+
+
+def write_result_files(stage: Path, outcome: MtpOutcome, note: str | None = None) -> None:
+    """The result files of ``outcome`` in the folder ``stage`` (§4.6, ``mtpSummary.txt``)."""
     setup = outcome.setup
     trial_times = [t.time for t in outcome.data.trials]
-    task = results.task("mtp_results") if stopped_after is None else results.stopped_task(stopped_after)
-    with task as stage:
-        outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)
-        outputs.parameter_file(stage, outcome.state, outcome.final_muscles, setup.model_muscles)
-        if setup.passive_trials:
-            modeled = passive_moments_at(outcome.final_muscles, setup.passive_trials)
-            outputs.passive_moment_files(stage, outcome.data.coordinates, setup.passive_trials, modeled)
-        outputs.osimx_file(
-            stage,
-            output_osimx_name(setup),
-            setup.model_name,
-            str(setup.settings.input_model_file),
-            outcome.state,
-            outcome.final_muscles,
-            write_max_isometric_force=outcome.mtli is not None and mtli_options(setup).update_max_isometric_force,
-            base=setup.input_osimx,
-        )
-        lines = [note] if note else []
-        lines += [f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; {t.wall_time:.2f} s"
-                  for t in outcome.tasks]
-        for t in outcome.tasks:
-            lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
-        lines.append(f"total wall time: {outcome.wall_time:.2f} s")
-        (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
-        histories = {"mtli": outcome.mtli.solution.history} if outcome.mtli is not None else {}
-        histories.update({f"task_{t.index}": t.history for t in outcome.tasks})
-        write_convergence_table(stage / CONVERGENCE_TABLE, histories)
+    outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)
+    outputs.parameter_file(stage, outcome.state, outcome.final_muscles, setup.model_muscles)
+    if setup.passive_trials:
+        modeled = passive_moments_at(outcome.final_muscles, setup.passive_trials)
+        outputs.passive_moment_files(stage, outcome.data.coordinates, setup.passive_trials, modeled)
+    outputs.osimx_file(
+        stage,
+        output_osimx_name(setup),
+        setup.model_name,
+        str(setup.settings.input_model_file),
+        outcome.state,
+        outcome.final_muscles,
+        write_max_isometric_force=outcome.mtli is not None and mtli_options(setup).update_max_isometric_force,
+        base=setup.input_osimx,
+    )
+    lines = [note] if note else []
+    lines += [f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; {t.wall_time:.2f} s"
+              for t in outcome.tasks]
+    for t in outcome.tasks:
+        lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
+    lines.append(f"total wall time: {outcome.wall_time:.2f} s")
+    (stage / "mtpSummary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    histories = {"mtli": outcome.mtli.solution.history} if outcome.mtli is not None else {}
+    histories.update({f"task_{t.index}": t.history for t in outcome.tasks})
+    write_convergence_table(stage / CONVERGENCE_TABLE, histories)
 
 
 def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOutcome:
@@ -320,6 +335,7 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
     max_iterations = options.pop("max_iterations", None)
     tolerance = float(options.pop("tolerance", 1e-6))
     keep_stopped = bool(options.pop("keep_finished_on_stop", True))
+    accept = bool(options.pop("accept_unconverged", False))
     if options:
         raise TypeError(f"unknown MTP options: {', '.join(options)}")
     setup = prepare(settings_file, emg_spline_stride=stride)
@@ -343,24 +359,57 @@ def run_settings(settings_file: str | os.PathLike[str], **options: Any) -> MtpOu
                      f"{sum(t.time.size for t in setup.data.trials)} frames, {len(setup.tasks)} task(s), "
                      f"SynX {'on' if setup.data.synx else 'off'}")
     start_data, mtli = initialize_lengths(setup)
+    failures = []
     if mtli is not None:
         _log(verbose, f"MTLI: {mtli.solution.status}, cost {mtli.solution.cost:.6g}")
+        if not mtli.solution.success:
+            failures.append(f"MTLI: IPOPT {mtli.solution.status} after {mtli.solution.iterations} iterations")
     finished: list[tuple[MtpData, MtpState, TaskOutcome]] = []
     try:
-        data, state, tasks = solve_tasks(setup, start_data, print_level=print_level, max_iterations=max_iterations,
-                                         tolerance=tolerance, verbose=verbose,
-                                         on_task=lambda k, d, s, o: finished.append((d, s, o)))
+        if failures and not accept:  # the tasks would start from an unconverged MTLI
+            data, state, tasks = start_data, MtpState.initial(start_data), []
+        else:
+            data, state, tasks = solve_tasks(setup, start_data, print_level=print_level,
+                                             max_iterations=max_iterations, tolerance=tolerance, verbose=verbose,
+                                             on_task=lambda k, d, s, o: finished.append((d, s, o)),
+                                             stop_unconverged=not accept)
     except KeyboardInterrupt:
         if keep_stopped:
             _keep_finished_tasks(setup, start_data, mtli, finished, results, start)
         raise
+    failures += [f"MTP task {t.index}: IPOPT {t.status} after {t.iterations} iterations"
+                 for t in tasks if not t.converged]
     plain, synx = evaluate(data, state)
     outcome = MtpOutcome(setup, start_data, data, state, mtli, tuple(tasks), plain, synx, results.path,
                          time.perf_counter() - start)
-    write_results(outcome, results)
+    stamp = settle(results, settings_file, failures, accept=accept,
+                   write=lambda folder: write_result_files(folder, outcome),
+                   diagnosis=lambda note: _diagnosis(outcome, note))
+    write_results(outcome, results, unconverged=stamp)
     results.copy_in(settings_file, Path(settings_file).name)
     summarize("MTP", summary_lines(outcome))
     return outcome
+
+
+def _diagnosis(outcome: MtpOutcome, note: str) -> str:
+    """``diagnosis.txt`` of an unconverged run: hints, then each solve's status and costs."""
+    lines = []
+    hints: list[str] = []
+    if outcome.mtli is not None:
+        m = outcome.mtli.solution
+        lines.append(f"MTLI: {m.status}; cost {m.cost:.10g}; {m.iterations} iterations")
+        if not m.success:
+            hints += status_hints(m.status, "the MTLI iteration limit")
+    for t in outcome.tasks:
+        lines.append(f"task {t.index}: {t.status}; cost {t.cost:.10g}; {t.iterations} iterations; "
+                     f"{t.wall_time:.2f} s")
+        lines += [f"  task {t.index} {name}: {value:.10g}" for name, value in t.term_costs.items()]
+        if not t.converged:
+            hints += status_hints(t.status, "<max_iterations>")
+    remaining = len(outcome.setup.tasks) - len(outcome.tasks)
+    if remaining:
+        lines.append(f"{remaining} later task(s) not run: they would start from this unconverged result")
+    return diagnosis_text(note, list(dict.fromkeys(hints)), "\n".join(lines))
 
 
 

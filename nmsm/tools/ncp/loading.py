@@ -90,9 +90,11 @@ def _old_scale_factors(extra: Sequence[str]) -> dict[str, float]:
     """``{field: factor}`` from a 2023 RCNLMuscle's unknown children (``*_scale_factor``)."""
     from lxml import etree
 
+    from nmsm.io.xml_input import xml_parser
+
     out = {}
     for item in extra:
-        element = etree.fromstring(item)
+        element = etree.fromstring(item, xml_parser())
         field = _OLD_SCALE_FACTORS.get(element.tag)
         if field is not None and (element.text or "").strip():
             out[field] = float(element.text)

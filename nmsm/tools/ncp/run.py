@@ -29,7 +29,8 @@ from nmsm.core.convergence import CONVERGENCE_TABLE, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
-from nmsm.errors import InputError, SolverError
+from nmsm.core.unconverged import LAST_ITERATE, diagnosis_text, settle, status_hints
+from nmsm.errors import InputError
 from nmsm.io.layout import trial_table_folders
 from nmsm.io.settings.document import read_settings_document
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
@@ -108,17 +109,17 @@ def solve(setup: NcpSetup, *, proximal_weight: float = PROXIMAL_WEIGHT, **ipopt_
     if "casadi_options" in ipopt_options and "casadi_options" in structured:
         options["casadi_options"] = {**structured["casadi_options"], **ipopt_options["casadi_options"]}
     solved = built.problem.solve("ipopt", **options)
-    if not solved.success and "Maximum_Iterations" not in solved.status and "Acceptable" not in solved.status:
-        raise SolverError(f"NCP optimization failed: IPOPT status {solved.status} after {solved.iterations} iterations")
     if "Acceptable" in solved.status:
         warnings.warn(f"NCP: IPOPT stopped at its acceptable level after {solved.iterations} iterations (objective "
                       f"unchanged to {ACCEPTABLE_STOP['acceptable_obj_change_tol']:g} over "
                       f"{ACCEPTABLE_STOP['acceptable_iter']} iterations, tolerance {ipopt_options.get('tol', 1e-8):g} not "
                       "reached: equal-cost synergy factorizations leave flat directions)", stacklevel=2)
-    elif not solved.success:
-        warnings.warn(f"NCP: IPOPT stopped with status {solved.status} after {solved.iterations} iterations; "
-                      "results written from the last iterate", stacklevel=2)
     return built.solution(solved), solved
+
+
+def converged(solved: Solution) -> bool:
+    """Whether IPOPT reached its tolerance or its acceptable level (:data:`ACCEPTABLE_STOP`)."""
+    return bool(solved.success) or "Acceptable" in solved.status
 
 
 def _log_text(setup: NcpSetup, solved: Solution, costs: dict[str, float], metrics: FitMetrics, wall: float) -> str:
@@ -193,6 +194,7 @@ def run_settings(
     print_level: int | None = None,
     proximal_weight: float = PROXIMAL_WEIGHT,
     plots: bool = False,
+    accept_unconverged: bool = False,
     **ipopt: Any,
 ) -> NcpRun:
     """Run NCP as the settings file ``path`` says.
@@ -202,6 +204,8 @@ def run_settings(
     ``proximal_weight`` (pull toward the start where the terms leave activations free, see
     :mod:`nmsm.tools.ncp.problem`); other keyword arguments go to the IPOPT back end. ``plots=True`` also saves the NCP
     figures (:func:`nmsm.plots.ncp.plot_ncp_results`) into ``<results>/plots``.
+    A solve that did not converge writes its last iterate into ``<results>/last_iterate/``
+    and raises :class:`~nmsm.errors.SolverError` unless ``accept_unconverged`` (:mod:`nmsm.core.unconverged`).
     """
     start = time.perf_counter()
     settings = read_settings(path)
@@ -231,24 +235,33 @@ def run_settings(
     metrics = fit_metrics(setup.inputs, solution)
     osimx_name = osimx_file_name(setup.osimx_file, settings.input_model_file)
     wall = time.perf_counter() - start
-    with results.task("ncp") as stage:
-        write_synergy_weights(stage / WEIGHTS_FILE, solution)
-        write_trial_files(stage, setup.inputs, solution)
+
+    def write(folder: Path) -> None:
+        write_synergy_weights(folder / WEIGHTS_FILE, solution)
+        write_trial_files(folder, setup.inputs, solution)
         osimx = ncp_osimx(
             setup.osimx,
             setup.model.name,
-            relative_model_path(Path(settings.input_model_file), out_dir),
+            relative_model_path(Path(settings.input_model_file), out_dir / LAST_ITERATE if folder.name == LAST_ITERATE
+                                else out_dir),
             setup.inputs,
             mtli_muscles=setup.mtli_muscles,
             updated_max_isometric_force=setup.mtli_muscles if setup.mtli_updated_force else (),
         )
-        write_ncp_osimx(stage / osimx_name, osimx)
-        write_run_info(stage / RUN_INFO_FILE, setup)
+        write_ncp_osimx(folder / osimx_name, osimx)
+        write_run_info(folder / RUN_INFO_FILE, setup)
+        (folder / LOG_FILE).write_text(_log_text(setup, solved, costs, metrics, wall), encoding="utf-8")
+        write_convergence_table(folder / CONVERGENCE_TABLE, {"ncp": solved.history})
+
+    failures = [] if converged(solved) else [f"NCP: IPOPT {solved.status} after {solved.iterations} iterations"]
+    stamp = settle(results, settings.settings_file, failures, accept=accept_unconverged, write=write,
+                   diagnosis=lambda note: diagnosis_text(note, status_hints(solved.status, "<max_iterations>"),
+                                                         _log_text(setup, solved, costs, metrics, wall)))
+    with results.task("ncp", unconverged=stamp) as stage:
+        write(stage)
         settings_copy = out_dir / Path(settings.settings_file).name
         if settings_copy.resolve() != Path(settings.settings_file).resolve():
             shutil.copy2(settings.settings_file, stage / settings_copy.name)
-        (stage / LOG_FILE).write_text(_log_text(setup, solved, costs, metrics, wall), encoding="utf-8")
-        write_convergence_table(stage / CONVERGENCE_TABLE, {"ncp": solved.history})
     if plots:
         from nmsm.plots.ncp import plot_ncp_results
 

@@ -23,7 +23,7 @@ def _pipeline(args: argparse.Namespace) -> int:
     from nmsm.tools.pipeline.runner import run_pipeline_file
 
     run = run_pipeline_file(args.pipeline, only=args.only or None, until=args.until, force=args.force or (),
-                            rebuild=args.rebuild, check_only=args.check)
+                            rebuild=args.rebuild, check_only=args.check, accept_unconverged=args.accept_unconverged)
     print(run.summary())
     return 0
 
@@ -152,6 +152,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("--check", action="store_true",
                    help="check the file and every stage's settings, show what would run and how it is wired; "
                         "run and write nothing")
+    p.add_argument("--accept-unconverged", action="store_true",
+                   help="a stage whose solve did not reach its stopping criterion writes its results (each file "
+                        "stamped UNCONVERGED) and the pipeline goes on (default: the stage keeps its last iterate "
+                        "in its last_iterate/ folder and the pipeline stops there)")
     p.set_defaults(func=_pipeline)
 
     p = subparsers.add_parser("example", help="the built-in synthetic subject: lab data to treatment, with the "

@@ -55,6 +55,7 @@ import attrs
 from lxml import etree
 
 from nmsm.errors import InputError, NmsmError
+from nmsm.io.xml_input import xml_parser
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS, Artifacts
 from nmsm.tools.pipeline.hashing import DigestCache, code_digest
 from nmsm.tools.pipeline.pipeline_file import PipelineSpec, StageSpec, read_pipeline
@@ -176,10 +177,24 @@ def _check_stage_options(spec: PipelineSpec, stage_options: dict[str, dict[str, 
                              file=spec.file, expected="options of its tool: " + ", ".join(known))
 
 
+def _with_accept_unconverged(spec: PipelineSpec, stage_options: dict[str, dict[str, Any]],
+                             accept: bool) -> dict[str, dict[str, Any]]:
+    """``stage_options`` with ``accept_unconverged=True`` for every optimizing stage when ``accept``."""
+    from nmsm.tools.dispatch import SOLVING_TOOLS
+
+    if not accept:
+        return stage_options
+    out = {name: dict(options) for name, options in stage_options.items()}
+    for stage in spec.stages:
+        if stage.kind.tool_element in SOLVING_TOOLS:
+            out.setdefault(stage.name, {})["accept_unconverged"] = True
+    return out
+
+
 def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until: str | None = None,
                  rebuild: bool = False, force: Iterable[str] = (), check_only: bool = False,
                  log: Callable[[str], None] | None = print, stage_options: dict[str, dict[str, Any]] | None = None,
-                 ) -> PipelineRun:
+                 accept_unconverged: bool = False) -> PipelineRun:
     """Run a parsed pipeline (see module docstring).
 
     ``only``: run just these stages (the others must be up to date when a selected stage
@@ -190,7 +205,9 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     of the run makes is bound when it runs, and the check says so) and report which stages
     would run and how they would be wired, without running or writing anything; every
     stage's errors are reported together. ``stage_options``: extra keyword arguments per stage
-    name for its tool's ``run_settings``.
+    name for its tool's ``run_settings``. ``accept_unconverged``: every optimizing stage
+    writes its results although its solve did not converge (stamped as unconverged,
+    :mod:`nmsm.core.unconverged`) instead of stopping the pipeline with its last iterate.
     """
     say = log or (lambda text: None)
     start = time.perf_counter()
@@ -198,6 +215,7 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
     force = (force,) if isinstance(force, str) else force
     _check_names(spec)
     _check_stage_options(spec, stage_options or {})
+    stage_options = _with_accept_unconverged(spec, stage_options or {}, accept_unconverged)
     check_order(spec)
     results = spec.results_directory
     _check_results_location(spec)
@@ -238,7 +256,8 @@ def run_pipeline(spec: PipelineSpec, *, only: Sequence[str] | None = None, until
             say(f"{head}: disabled")
             continue
         settings, wired = prepare_stage(stage, artifacts, results)
-        digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}", code_digest())
+        accepted = "-accept-unconverged" if stage_options.get(stage.name, {}).get("accept_unconverged") else ""
+        digest = settings.input_digest(cache, stage.kind.code, f"state-version-{VERSION}{accepted}", code_digest())
         record = state.records.get(stage.name)
         waits = any(a in pending for a in (*stage.kind.requires, *stage.kind.uses))
         current = (record is not None and record.input_digest == digest and record.kind == stage.kind.code
@@ -552,7 +571,7 @@ def _point_at_user_settings(exc: InputError, settings_file: Path, text: str, set
     try:
         if Path(exc.file).resolve() != settings_file.resolve():
             return
-        written = etree.fromstring(text.encode())
+        written = etree.fromstring(text.encode(), xml_parser())
     except (OSError, etree.XMLSyntaxError):
         return
     lines: dict[int, int] = {}

@@ -36,6 +36,7 @@ import numpy as np
 from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import SUPERSEDED, ResultsDirectory
+from nmsm.core.unconverged import ACCEPT_OPTION, status_hints, unconverged_note, warn_accepted, write_last_iterate
 from nmsm.errors import InputError, SolverError
 from nmsm.tools.treatment.diagnosis import convergence_summary
 from nmsm.tools.treatment.solution import TreatmentSolution
@@ -273,28 +274,18 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
     tsol = TreatmentSolution(prepared.built, solution, trial)
     summary = convergence_summary(prepared.built, solution)
     files: list[Path] = []
+    stamp = None
     if not solution.success:
-        saved, note = None, ""
-        if results is not None:
-            from nmsm.tools.treatment.outputs import write_solution
-
-            if results.retire(trial):
-                note = (f"; the results an earlier run wrote for trial '{trial}' were moved to "
-                        f"{Path(results.path) / SUPERSEDED}")
-            with results.task("last_iterate") as stage:
-                target = stage / "last_iterate"
-                write_solution(target, tsol, summary=summary)
-                (target / "diagnosis.txt").write_text(_diagnosis(prepared, solution, summary), encoding="utf-8")
-                if log is not None and log.is_file():
-                    shutil.copy2(log, target / log.name)
-            saved = str(Path(results.path) / "last_iterate")
-        raise SolverError(f"{settings.settings_file}: IPOPT did not converge ({solution.status} after "
-                          f"{solution.iterations} iterations){_not_finite(solution)}{note}", last_iterate_path=saved)
+        failure = f"IPOPT did not converge ({solution.status} after {solution.iterations} iterations)"
+        if not opts.accept_unconverged:
+            _keep_last_iterate(settings, prepared, solution, tsol, summary, results, log, failure)
+        stamp = unconverged_note([failure])
+        warn_accepted(settings.settings_file, stamp)
     if results is not None:
         from nmsm.tools.treatment.design import parameter_tables, write_parameter_solution
         from nmsm.tools.treatment.outputs import write_solution
 
-        with results.task(trial) as stage:
+        with results.task(trial, unconverged=stamp) as stage:
             files = write_solution(stage, tsol, summary=summary, extra_tables=parameter_tables(prepared, tsol))
             files += write_parameter_solution(stage, prepared, tsol)
             if (Path(results.path) / Path(path).name).resolve() != Path(path).resolve():  # not the settings itself
@@ -306,15 +297,34 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
                         files, build_time)
 
 
+def _keep_last_iterate(settings: Any, prepared: Prepared, solution: Solution, tsol: TreatmentSolution, summary: str,
+                       results: ResultsDirectory | None, log: Path | None, failure: str) -> None:
+    """The unconverged-result policy (:mod:`nmsm.core.unconverged`): the earlier run's results
+    of the trial into ``superseded/``, the last iterate and the diagnosis into
+    ``<results>/last_iterate/``; raises :class:`SolverError`."""
+    trial = settings.trial_name
+    saved, note = None, ""
+    if results is not None:
+        from nmsm.tools.treatment.outputs import write_solution
+
+        if results.retire(trial):
+            note = (f"; the results an earlier run wrote for trial '{trial}' were moved to "
+                    f"{Path(results.path) / SUPERSEDED}")
+
+        def write(folder: Path) -> None:
+            write_solution(folder, tsol, summary=summary)
+            if log is not None and log.is_file():
+                shutil.copy2(log, folder / log.name)
+
+        saved = write_last_iterate(results, write, _diagnosis(prepared, solution, summary),
+                                   unconverged_note([failure]))
+    raise SolverError(f"{settings.settings_file}: {failure}{_not_finite(solution)}{note}; {ACCEPT_OPTION} writes "
+                      "the results anyway, stamped as unconverged",
+                      last_iterate_path=str(saved) if saved is not None else None)
+
+
 def _diagnosis(prepared: Prepared, solution: Solution, summary: str) -> str:
-    hints = []
-    if solution.status == "Maximum_Iterations_Exceeded":
-        hints.append("IPOPT reached <setup_nlp_max_iterations>: raise it, or start from a better initial guess.")
-    if "Infeasible" in solution.status:
-        hints.append("IPOPT found the constraints locally infeasible: check the constraint bounds listed as VIOLATED "
-                     "below (min_error/max_error), the variable bounds (range scale factors) and the initial guess.")
-    if "Restoration" in solution.status:
-        hints.append("IPOPT's restoration phase failed: the problem may be infeasible or badly scaled near the guess.")
+    hints = status_hints(solution.status, "<setup_nlp_max_iterations>")
     if prepared.warnings:
         hints.append("Input warnings:\n  " + "\n  ".join(prepared.warnings))
     return "Diagnosis\n=========\n" + ("\n".join(hints) + "\n\n" if hints else "") + summary + "\n"

@@ -61,7 +61,9 @@ class TreatmentOptions:
     initial guess folder holds a previous result (``<trial>_states.sto``), as verification
     should reproduce that motion rather than drift inside the constraint bounds.
     ``evaluate_only``: build, evaluate the cost at the
-    starting point, do not solve.
+    starting point, do not solve. ``accept_unconverged``: write the results of a solve that
+    did not converge, stamped as unconverged (:mod:`nmsm.core.unconverged`), instead of only
+    its last iterate.
     """
 
     results_directory: Path | None = None
@@ -80,6 +82,7 @@ class TreatmentOptions:
     parallel: int = DEFAULT_PARALLEL
     evaluate_only: bool = False
     write_results: bool = True
+    accept_unconverged: bool = False
 
 
 @attrs.define
