@@ -10,7 +10,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
+import signal
 import sys
+import threading
 import warnings
 from collections.abc import Iterator, Sequence
 from typing import Any
@@ -124,7 +126,10 @@ def each_warning_once() -> Iterator[None]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line ``argv`` (default: the process's own, ``sys.argv``; then a
+    Ctrl-C after the command finished is ignored until the process exits)."""
     parser = build_parser()
+    own_command_line = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     misplaced = _misplaced_global_option(parser, argv)
     if misplaced:
@@ -135,17 +140,32 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     warnings.simplefilter("default")
     warnings.formatwarning = lambda msg, cat, *a, **k: f"warning: {msg}\n"
+    status: int | None = None
     try:
         with progress_every(args.progress), console_output(), each_warning_once():
-            return int(args.func(args) or 0)
+            status = int(args.func(args) or 0)
+            if own_command_line:
+                _ignore_late_interrupts()
     except NmsmError as exc:
         if args.traceback:
             raise
         print(f"nmsm: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
+        if status is not None:  # the command had finished: its results are complete
+            if own_command_line:
+                _ignore_late_interrupts()
+            return status
         print("nmsm: stopped; the interrupted task wrote nothing, finished tasks and stages are kept", file=sys.stderr)
         return 130
+    return status
+
+
+def _ignore_late_interrupts() -> None:
+    """Ignore Ctrl-C once the command has finished, so one arriving while nmsm exits (closing
+    the OpenSim worker, joining threads) does not turn complete results into a stopped run."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 if __name__ == "__main__":

@@ -70,3 +70,56 @@ def test_a_warning_is_shown_once_per_command(shared_data, tmp_path, recwarn):
     assert code == 0
     repeated = [w for w in recwarn if "repeat the previous row" in str(w.message)]
     assert len(repeated) == 1
+
+
+#: a parser with one command that finishes at once (``done``), for the Ctrl-C tests
+FAST_PARSER = """
+import argparse
+from nmsm import cli
+
+
+def fast_parser():
+    parser = argparse.ArgumentParser(prog="nmsm")
+    parser.add_argument("--traceback", action="store_true")
+    parser.add_argument("--progress", type=float, default=0.0)
+    parser.add_subparsers().add_parser("done").set_defaults(func=lambda args: 0)
+    return parser
+
+
+cli.build_parser = fast_parser
+"""
+
+
+def test_ctrl_c_after_the_command_finished_keeps_its_exit_status(tmp_path: Path) -> None:
+    """A Ctrl-C arriving after the results were saved (nmsm exiting: the OpenSim worker
+    closing, threads joining) leaves the exit status 0, not death by SIGINT."""
+    import os
+
+    script = FAST_PARSER + ("import os, signal, sys, time\n"
+                            "sys.argv = ['nmsm', 'done']\n"
+                            "code = cli.main()\n"
+                            "os.kill(os.getpid(), signal.SIGINT)\n"
+                            "time.sleep(0.5)\n"
+                            "sys.exit(code)\n")
+    done = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])})
+    assert done.returncode == 0, done.stderr[-2000:]
+
+
+def test_ctrl_c_while_leaving_a_finished_command_is_not_a_stop(monkeypatch, capsys) -> None:
+    import contextlib
+
+    from nmsm import cli
+
+    namespace: dict = {}
+    exec(FAST_PARSER, namespace)  # noqa: S102 - the parser above, in this process
+    monkeypatch.setattr(cli, "build_parser", namespace["fast_parser"])
+
+    @contextlib.contextmanager
+    def interrupted_on_exit(seconds):
+        yield
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "progress_every", interrupted_on_exit)
+    assert cli.main(["done"]) == 0
+    assert "stopped" not in capsys.readouterr().err
