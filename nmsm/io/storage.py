@@ -247,6 +247,7 @@ def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy
             comments.append(raw.rstrip())
     while comments and not comments[-1].strip():
         comments.pop()
+    in_degrees = _in_degrees(metadata, lines[:end], source)
     label_index = next((i for i in range(end + 1, len(lines)) if lines[i].strip()), None)
     if label_index is None:
         raise InputError(
@@ -308,7 +309,6 @@ def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy
         warnings.warn(
             f"{source}: header says nRows={n_rows} but the file has {n_read} rows; using the rows", stacklevel=3
         )
-    in_degrees = metadata.get("inDegrees", "no").strip().lower() == "yes"
     return Table(
         time=time,
         labels=labels,
@@ -320,6 +320,19 @@ def parse_storage(text: str, *, source: Path | None = None, allow_nan: NanPolicy
         source=source,
         label_line=label_line,
     )
+
+
+def _in_degrees(metadata: dict[str, str], header: list[str], source: Path | None) -> bool:
+    """The ``inDegrees`` header: ``yes`` or ``no`` (any case; missing: no). OpenSim reads
+    every other value (``true``, ``1``, ...) as radians without a word, so such a value is
+    refused rather than guessed."""
+    value = metadata.get("inDegrees")
+    if value is None or value.strip().lower() in ("yes", "no"):
+        return value is not None and value.strip().lower() == "yes"
+    line = next((i + 1 for i, text in enumerate(header) if text.strip().startswith("inDegrees")), None)
+    raise InputError(f"inDegrees={value.strip()}: OpenSim reads only 'yes' as degrees and would read this file as "
+                     "radians", file=source, line=line, element="inDegrees",
+                     expected="inDegrees=yes (angles in degrees) or inDegrees=no (radians)")
 
 
 def _raise_empty_cell(line: str, header: list[str], source: Path | None, number: int) -> None:

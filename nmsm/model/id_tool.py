@@ -106,6 +106,9 @@ def motion_coordinates(model: Model, motion: Table) -> tuple[np.ndarray, list[st
     when none matches, a warning for absent coordinates, unknown columns or an implausible
     angle unit).
     """
+    if motion.n_rows == 0:
+        raise InputError("the motion has column labels but no rows", file=motion.source,
+                         expected="at least one row of coordinate values after the column labels")
     missing = check_motion_columns(model, motion)
     by_name = _coordinate_columns(motion)
     values = np.zeros((motion.n_rows, len(model.coordinates)))
@@ -214,10 +217,28 @@ def inverse_dynamics_of_motion(
         columns.append(_ground_loads(cm, sampled, q))
     function = cm.inverse_dynamics_function(bodies, include_contact=include_contact)
     tau = np.array(function.map(out_times.size, "thread", SOLVER_THREADS)(*columns)).T  # (m, n) model order
+    _check_finite(tau, out_times, model, motion, values)
     order = [model.coordinate_index(name) for name in model.tree_coordinate_names]
     labels = generalized_force_labels(model)
     return table_from_columns(out_times, {label: tau[:, i] for label, i in zip(labels, order)},
                               name="Inverse Dynamics Generalized Forces")
+
+
+def _check_finite(tau: np.ndarray, times: np.ndarray, model: Model, motion: Table, values: np.ndarray) -> None:
+    """Refuse generalized forces ``tau`` ``(m, n_coordinates)`` that are not finite (values
+    so large that the dynamics overflow), naming the motion, the first frame and the largest
+    coordinate value."""
+    bad = ~np.isfinite(tau).all(axis=1)
+    if not bad.any():
+        return
+    first = int(np.flatnonzero(bad)[0])
+    largest = int(np.unravel_index(np.argmax(np.abs(values)), values.shape)[1]) if values.size else 0
+    name = model.coordinates[largest].name if model.coordinates else "?"
+    raise InputError(f"inverse dynamics is not finite at {int(bad.sum())} of {times.size} frames (first at t = "
+                     f"{times[first]:g} s): the motion's values are out of range (largest: {name} "
+                     f"{np.abs(values).max():.3g})", file=motion.source, element=f"column '{name}'",
+                     expected="coordinate values within the model's range (radians, or degrees with inDegrees=yes; "
+                     "metres)")
 
 
 def _ground_loads(cm: CasadiModel, sampled: list, q: np.ndarray) -> np.ndarray:

@@ -169,8 +169,13 @@ class _Parser:
                 raise r.error(elem, f"two bodies are named '{name}'", expected="unique body names")
             i6 = r.floats(elem, "inertia", [0, 0, 0, 0, 0, 0], size=6)
             inertia = np.array([[i6[0], i6[3], i6[4]], [i6[3], i6[1], i6[5]], [i6[4], i6[5], i6[2]]])
-            bodies[name] = Body(name, path, r.float(elem, "mass", 0.0),
-                                r.floats(elem, "mass_center", [0, 0, 0], size=3), inertia)
+            mass, center = r.float(elem, "mass", 0.0), r.floats(elem, "mass_center", [0, 0, 0], size=3)
+            for tag, values in (("mass", [mass]), ("mass_center", center), ("inertia", i6)):
+                if not np.all(np.isfinite(values)):
+                    raise r.error(elem, f"body '{name}': <{tag}> is not finite", expected="finite numbers")
+            if mass < 0:  # OpenSim refuses it too ("unspecified or negative mass")
+                raise r.error(elem, f"body '{name}' has negative mass {mass:g} kg", expected="a mass >= 0 kg")
+            bodies[name] = Body(name, path, mass, center, inertia)
         return bodies
 
     # ------------------------------------------------------------------ joints
@@ -197,6 +202,9 @@ class _Parser:
         if elem is None:
             return Coordinate(name, joint, motion, DEFAULT_COORDINATE_RANGE)
         rng = r.floats(elem, "range", DEFAULT_COORDINATE_RANGE, size=2)
+        if np.isnan(rng).any() or rng[0] > rng[1]:
+            raise r.error(elem, f"coordinate '{name}': <range> {rng[0]:g} {rng[1]:g} is not a range",
+                          expected="<range>MIN MAX</range> with MIN <= MAX (rad, or m for translations)")
         return Coordinate(
             name, joint, motion, (float(rng[0]), float(rng[1])),
             default_value=r.float(elem, "default_value", 0.0),
@@ -414,6 +422,20 @@ def _custom_motion_type(coordinate: str, axes: tuple[TransformAxis, ...]) -> str
     return motion or "coupled"
 
 
+#: characters OpenSim forbids in a component name (the path separator among them)
+INVALID_NAME_CHARACTERS = "/\\"
+
+
+def _check_component_names(r: XmlReader) -> None:
+    """Refuse a component name holding a character OpenSim forbids (``/`` separates the parts
+    of a component path; names also become parts of output file names)."""
+    for elem in r.model.iter():
+        name = elem.get("name") if isinstance(elem.tag, str) else None
+        if name and any(c in name for c in INVALID_NAME_CHARACTERS):
+            raise r.error(elem, f"the name '{name}' holds '/' or '\\', which OpenSim forbids in component names",
+                          expected="a name without '/' or '\\' (e.g. '_' instead)")
+
+
 def parse_model_document(root: etree._Element, file: str | Path, *, version: int = 0,
                          source_file: str | Path | None = None) -> Model:
     """The model in the XML tree ``root`` (an ``OpenSimDocument`` or ``Model`` element).
@@ -422,6 +444,7 @@ def parse_model_document(root: etree._Element, file: str | Path, *, version: int
     """
     parser = _Parser(root, str(file))
     r = parser.reader
+    _check_component_names(r)
     parser.parse_frames()
     bodies = parser.parse_bodies()
     joints, coordinates = parser.parse_joints()
