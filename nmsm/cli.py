@@ -21,7 +21,7 @@ from nmsm import __version__
 from nmsm.cli_types import non_negative_float
 from nmsm.core.console import console_output
 from nmsm.core.progress import DEFAULT_INTERVAL, progress_every
-from nmsm.errors import NmsmError
+from nmsm.errors import NmsmError, os_error
 
 #: options of ``nmsm`` itself: they go before the sub-command (``nmsm --progress 5 id ...``)
 GLOBAL_OPTIONS: tuple[str, ...] = ("--progress", "--traceback")
@@ -150,6 +150,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.traceback:
             raise
         print(f"nmsm: error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        error = os_error(exc)
+        if error is None or args.traceback:
+            raise
+        print(f"nmsm: error: {error}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         if status is not None:  # the command had finished: its results are complete

@@ -6,6 +6,7 @@ expected, so a user can fix the input without reading nmsm's source.
 
 from __future__ import annotations
 
+import errno
 from os import PathLike
 
 
@@ -69,3 +70,25 @@ class SolverError(NmsmError):
 
 class BridgeError(NmsmError):
     """An error reported by OpenSim running in the bridge's worker process."""
+
+
+#: what to do about an operating-system error, by ``errno``
+_OS_ADVICE = {
+    errno.ENAMETOOLONG: "names of at most 255 bytes per file or folder name (and a shorter path): rename or move it",
+    errno.ENOSPC: "free space on that disk, or results written to another disk (nmsm run -o RESULTS_DIR); "
+                  "nothing half-written was left",
+    errno.EDQUOT: "disk quota left, or results written elsewhere (nmsm run -o RESULTS_DIR)",
+    errno.EROFS: "a writable file system (nmsm run -o RESULTS_DIR writes elsewhere)",
+    errno.EACCES: "permission to read or write that path",
+    errno.EPERM: "permission to read or write that path",
+}
+
+
+def os_error(exc: OSError) -> InputError | None:
+    """The :class:`InputError` naming the path and what to do for an operating-system error
+    that input or the machine causes (a name too long, a full disk, no permission, a
+    read-only file system); None for other errors."""
+    advice = _OS_ADVICE.get(exc.errno) if exc.errno is not None else None
+    if advice is None:
+        return None
+    return InputError(exc.strerror or str(exc), file=exc.filename, expected=advice)

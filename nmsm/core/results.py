@@ -174,9 +174,11 @@ class ResultsDirectory:
         stage = Path(tempfile.mkdtemp(prefix=f".staging-{_safe(name)}-", dir=self.ensure()))
         try:
             yield stage
-        except BaseException:
+        except BaseException as exc:
             shutil.rmtree(stage, ignore_errors=True)
             self.remove_if_unused()
+            if isinstance(exc, OSError) and exc.filename is None:  # e.g. a full disk while writing: name the folder
+                exc.filename = str(self.path)
             raise
         try:
             if unconverged is not None:

@@ -86,6 +86,22 @@ def normalize_separators(text: str) -> str:
     return text.strip().replace("\\", "/")
 
 
+#: the longest file or folder name (bytes) of common file systems (ext4, NTFS, APFS)
+NAME_MAX = 255
+
+
+def check_name_lengths(path: Path, *, settings_file: str | os.PathLike[str] | None = None, line: int | None = None,
+                       element: str | None = None) -> None:
+    """Refuse a path with a file or folder name longer than :data:`NAME_MAX` bytes (the
+    operating system would refuse to look it up, with ``OSError`` ENAMETOOLONG)."""
+    for part in path.parts:
+        if len(os.fsencode(part)) > NAME_MAX:
+            shown = part[:40] + "..." + part[-20:]
+            raise InputError(f"the name '{shown}' in the path is {len(os.fsencode(part))} bytes long", file=settings_file,
+                             line=line, element=element,
+                             expected=f"file and folder names of at most {NAME_MAX} bytes")
+
+
 def _kind_ok(path: Path, kind: str) -> bool:
     if kind == "file":
         return path.is_file()
@@ -207,6 +223,7 @@ def resolve_path(
     check_not_windows_absolute(text, settings_file=settings_file, line=line, element=where)
     cleaned = normalize_separators(text)
     path = Path(cleaned)
+    check_name_lengths(path, settings_file=settings_file, line=line, element=where)
     settings_dir = Path(settings_file).resolve().parent if settings_file else Path.cwd()
     candidates: Sequence[tuple[Path, str | None]]
     if path.is_absolute():

@@ -247,9 +247,11 @@ def _work_folder(results: ResultsDirectory) -> Iterator[Path]:
     work = Path(tempfile.mkdtemp(prefix=".jmp-task-", dir=results.ensure()))
     try:
         yield work
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(work, ignore_errors=True)
         results.remove_if_unused()
+        if isinstance(exc, OSError) and exc.filename is None:  # e.g. a full disk while writing: name the folder
+            exc.filename = str(results.path)
         raise
     shutil.rmtree(work, ignore_errors=True)
 
