@@ -160,7 +160,28 @@ def _write_passive_trials(folder: Path, model: Any, casadi_model: Any, muscles: 
 
 
 def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> Subject:
-    """Generate the subject into ``folder`` (see module docstring); ``log``: progress lines."""
+    """Generate the subject into ``folder`` (see module docstring); ``log``: progress lines.
+
+    The files are written into a staging folder inside ``folder`` and moved into place all or
+    none when every one is complete (:class:`~nmsm.core.results.ResultsDirectory`, as results
+    are): a stop, a kill or a full disk while generating never leaves a truncated subject that
+    :func:`subject_in` would take as complete.
+    """
+    from nmsm.core.results import ResultsDirectory
+
+    say = log or (lambda text: None)
+    folder = Path(folder)
+    with ResultsDirectory(folder).task("subject") as stage:
+        peak = _write_subject(stage, seed=seed, say=say)
+    subject = subject_in(folder)
+    if subject is None:
+        raise RuntimeError(f"{folder}: the subject's files were moved into place but are incomplete")
+    say(f"subject written to {folder} (peak vertical ground reaction {peak:.0f} N)")
+    return subject
+
+
+def _write_subject(folder: Path, *, seed: int, say: Any) -> float:
+    """Write the subject's files into ``folder``; returns the peak vertical ground reaction (N)."""
     from nmsm.examples.subject_data import (excitations_from_activations, ground_reaction, marker_table,
                                             raw_emg)
     from nmsm.examples.subject_simulation import (MuscleArrays, SubjectDynamics, design_synergies,
@@ -177,8 +198,6 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
     from nmsm.tools.gcp.foot_model import FootMarkers, FootModel
     from nmsm.tools.gcp.spring_grid import place_springs
 
-    say = log or (lambda text: None)
-    folder = Path(folder)
     inputs, truth_dir = folder / "subject", folder / "truth"
     inputs.mkdir(parents=True, exist_ok=True)
     truth_dir.mkdir(parents=True, exist_ok=True)
@@ -236,8 +255,7 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
     analog_index = np.searchsorted(simulation.time, analog_times - 1e-9)
     reaction = ground_reaction(GRF_NAME, "calcn_r", analog_times, simulation.force[analog_index],
                                simulation.moment[analog_index])
-    external_loads, grf_file = write_external_loads(inputs / f"{TRIAL}_grf.xml", [reaction],
-                                                    inputs / f"{TRIAL}_grf.mot")
+    write_external_loads(inputs / f"{TRIAL}_grf.xml", [reaction], inputs / f"{TRIAL}_grf.mot")
     arrays = MuscleArrays.of(muscles)
     excitation, clipped = excitations_from_activations(simulation.time, simulation.a, arrays.tau_a,
                                                       arrays.nonlinearity)
@@ -254,7 +272,7 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
                                        seed=seed, duration=2.0)
 
     say("writing the passive trials for MTLI")
-    passive_folder = _write_passive_trials(inputs / "passive", model, cm, muscles)
+    _write_passive_trials(inputs / "passive", model, cm, muscles)
 
     # truth
     np.savez_compressed(truth_dir / "simulation.npz", time=simulation.time, q=simulation.q, u=simulation.u,
@@ -276,10 +294,5 @@ def make_subject(folder: str | os.PathLike[str], *, seed: int = 0, log=None) -> 
             for s in surface.springs]},
         "peak_vertical_force": float(simulation.force[:, 1].max()),
     }
-    truth_file = truth_dir / "truth.json"
-    truth_file.write_text(json.dumps(truth, indent=1), encoding="utf-8")
-    say(f"subject written to {folder} (peak vertical ground reaction {truth['peak_vertical_force']:.0f} N)")
-    return Subject(folder=folder, generic_model=generic_model, true_model=true_model,
-                   calibration_settings=jmp_case.settings_file, calibration_markers=jmp_case.marker_file,
-                   gait_markers=gait_markers, grf_file=grf_file, external_loads=external_loads, emg_file=emg_file,
-                   truth_file=truth_file, true_contact=true_contact, passive_folder=passive_folder)
+    (truth_dir / "truth.json").write_text(json.dumps(truth, indent=1), encoding="utf-8")
+    return float(truth["peak_vertical_force"])
