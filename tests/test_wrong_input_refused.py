@@ -92,3 +92,19 @@ def test_the_toy_model_itself_loads(shared_data: Path, tmp_path: Path) -> None:
 
     shutil.copy(shared_data / TOY / "simple_arm.osim", tmp_path / "arm.osim")
     assert "r_elbow_flex" in load_model(tmp_path / "arm.osim").coordinate_names
+
+
+def test_a_negative_max_allowable_error_is_refused_also_where_unused(shared_data: Path, tmp_path: Path) -> None:
+    """NCP V1's first term (MTLI's, a block that is not enabled) was read with -2 and the run went on."""
+    from nmsm.io.settings import read_tool_settings
+
+    source = shared_data / "ncp/uf_subject3_tutorial/CompletedSettingsFiles/NCPSettingsV1.xml"
+    text = source.read_text(encoding="utf-8")
+    first = text.index("<max_allowable_error>")
+    end = text.index("</max_allowable_error>", first)
+    line = text[:first].count("\n") + 1
+    path = tmp_path / "NCPSettingsV1.xml"
+    path.write_text(text[:first] + "<max_allowable_error>-2" + text[end:], encoding="utf-8")
+    with pytest.raises(InputError) as caught:
+        read_tool_settings(path, check_paths=False)
+    assert str(caught.value).startswith(f"{path}:{line}: <max_allowable_error>: ") and "> 0" in str(caught.value)

@@ -317,6 +317,18 @@ class SettingsDocument:
                 out.append(self.term_spec(term, term_kind))
         return out
 
+    def _check_allowable_error(self, term: etree._Element, term_type: str) -> None:
+        """A ``<max_allowable_error>`` that is a number <= 0 is an error where it is written,
+        also in a block that is not enabled (its terms are built only when it is used)."""
+        element = term.find("max_allowable_error")
+        try:
+            value = float(self.text_of(element)) if element is not None else 1.0
+        except ValueError:
+            return  # not a number: the term reports it when it is built
+        if not value > 0:
+            raise self.error(element, f"term '{term_type}': 'max_allowable_error' must be > 0 (got {value})",
+                             expected="a number > 0")
+
     def term_spec(self, term: etree._Element, kind: str) -> TermSpec:
         fields: dict[str, str] = {}
         lines: dict[str, int] = {}
@@ -341,6 +353,7 @@ class SettingsDocument:
                 element="<type>",
                 expected="the term's type name",
             )
+        self._check_allowable_error(term, term_type)
         return TermSpec(kind=kind, type=term_type, fields=fields, source=self.source(term), field_lines=lines)
 
 
