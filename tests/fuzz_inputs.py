@@ -25,15 +25,18 @@ import attrs
 
 #: values put in place of a number or a word of an input file
 ODD_VALUES = ("nan", "inf", "-inf", "-1", "0", "1e308", "-1e308", "1e-320", "2147483648", "", " ", "abc", "1,5",
-              "0x10", "true", "yes", "\u22121", "\u00e9", "a" * 300, "../" * 20 + "x", "/", "&amp;", "<!-- c -->")
+              "0x10", "true", "yes", "\u22121", "\u00e9", "a" * 300, "a" * 300 + ".osim", "x/" + "b" * 256 + "/y.sto",
+              "../" * 20 + "x", "/", "&amp;", "<!-- c -->")
+_TEXT = re.compile(rb">\s*([^<>\s][^<>]*?)\s*<")
 #: bytes put into a file
 ODD_BYTES = (b"\x00", b"\xff\xfe", b"\xe9", b"<", b">", b"&", b"]]>", b"\r", b"\t", b"\n\n", b"<!DOCTYPE r>", b"=")
 _TOKEN = re.compile(rb"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|[A-Za-z_][\w.]*")
 
 
 def mutate(data: bytes, rng: random.Random) -> bytes:
-    """One to three random edits of ``data``: a token replaced by an odd value, bytes
-    inserted, deleted, duplicated or truncated, two lines swapped."""
+    """One to three random edits of ``data``: a token or an element's text replaced by an
+    odd value, a path given an overlong or odd name, bytes inserted, deleted, duplicated or
+    truncated, two lines swapped."""
     for _ in range(rng.randint(1, 3)):
         data = rng.choice(_MUTATORS)(data, rng)
     return data
@@ -45,6 +48,35 @@ def _replace_token(data: bytes, rng: random.Random) -> bytes:
         return data
     match = rng.choice(tokens)
     return data[:match.start()] + rng.choice(ODD_VALUES).encode() + data[match.end():]
+
+
+def _replace_text(data: bytes, rng: random.Random) -> bytes:
+    """The text of a random XML element (or a random line of a table) replaced by an odd value."""
+    texts = list(_TEXT.finditer(data))
+    if not texts:
+        lines = data.split(b"\n")
+        lines[rng.randrange(len(lines))] = rng.choice(ODD_VALUES).encode()
+        return b"\n".join(lines)
+    match = rng.choice(texts)
+    return data[:match.start(1)] + rng.choice(ODD_VALUES).encode() + data[match.end(1):]
+
+
+_PATH_TEXT = re.compile(rb">\s*([^<>\s]*(?:/|\\|\.(?:osimx?|xml|trc|mot|sto))[^<>\s]*)\s*<")
+
+
+def _long_path(data: bytes, rng: random.Random) -> bytes:
+    """A path written in the file (an element's text with a folder separator or a data file's
+    extension) with one name made longer than file systems allow, or replaced by odd text."""
+    paths = list(_PATH_TEXT.finditer(data))
+    if not paths:
+        return _replace_text(data, rng)
+    match = rng.choice(paths)
+    text = match.group(1)
+    parts = re.split(rb"([/\\])", text)
+    names = [k for k in range(0, len(parts), 2)]
+    k = rng.choice(names)
+    parts[k] = rng.choice((b"n" * 256, b"n" * 300 + parts[k], parts[k] + b"\x00", b"", b"..", b"~"))
+    return data[:match.start(1)] + b"".join(parts) + data[match.end(1):]
 
 
 def _insert(data: bytes, rng: random.Random) -> bytes:
@@ -81,7 +113,8 @@ def _swap_lines(data: bytes, rng: random.Random) -> bytes:
 
 
 _MUTATORS: tuple[Callable[[bytes, random.Random], bytes], ...] = (
-    _replace_token, _replace_token, _replace_token, _insert, _delete, _duplicate, _truncate, _swap_lines)
+    _replace_token, _replace_token, _replace_text, _replace_text, _long_path, _insert, _delete, _duplicate,
+    _truncate, _swap_lines)
 
 
 @attrs.define
