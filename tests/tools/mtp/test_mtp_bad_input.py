@@ -23,6 +23,8 @@ TERMS = """
 
 def write_settings(folder: Path, tutorial: Path, *, channels: str = "GlutMaxLat RecFem BicFemLong BicFemShort VastMed GasMed Sol TibAnt",
                    osimx: str = "") -> Path:
+    """A short MTP run of the tutorial's data (50 iterations, one task: it stops before IPOPT's
+    tolerance, so its callers accept unconverged results)."""
     text = f"""<NMSMPipelineDocument Version="1.5.0"><MuscleTendonPersonalizationTool>
  <results_directory>results</results_directory>
  <input_model_file>{tutorial / 'UF_Subject_3_reduced_muscles.osim'}</input_model_file>
@@ -47,7 +49,7 @@ def write_settings(folder: Path, tutorial: Path, *, channels: str = "GlutMaxLat 
 
 def test_runs_clean(case):
     folder, tutorial = case
-    outcome = run_settings(write_settings(folder, tutorial))
+    outcome = run_settings(write_settings(folder, tutorial), accept_unconverged=True)
     assert (folder / "results" / "UF_Subject_3_reduced_muscles_mtp.osimx").is_file()
     assert np.isfinite(outcome.tasks[0].cost)
 
@@ -139,7 +141,7 @@ def test_tiny_tendon_slack_length_gives_finite_results(case):
     settings = write_settings(folder, tutorial, osimx=str(osimx))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        outcome = run_settings(settings, max_iterations=30)
+        outcome = run_settings(settings, max_iterations=30, accept_unconverged=True)
     assert np.isfinite(outcome.tasks[0].cost)
     for path in (folder / "results").rglob("*.sto"):
         assert np.all(np.isfinite(read_storage(path).data)), path.name
