@@ -33,7 +33,8 @@ def _run(tutorial, folder, feet, max_iterations=None, update_motion=False):
     settings = write_two_feet_tutorial(tutorial, folder, feet=feet, max_iterations=max_iterations)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return run_settings(settings, update_motion=update_motion)
+        # a few evaluations per task (or the tutorial's limit): accepted, stamped as unconverged
+        return run_settings(settings, update_motion=update_motion, accept_unconverged=True)
 
 
 def _runs(tutorial, tmp_path_factory, max_iterations):
