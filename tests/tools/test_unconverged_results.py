@@ -131,3 +131,25 @@ def test_nmsm_run_exits_1_and_accepts_with_the_option(shared_data: Path, tmp_pat
     assert _visible(out) == [LAST_ITERATE]
     assert main(["run", str(settings), "-o", str(out), "--accept-unconverged"]) == 0
     assert "UNCONVERGED" in (out / "translation_result_from_xml.osim").read_text()
+
+
+def test_the_pipeline_option_reaches_every_optimizing_stage() -> None:
+    """``nmsm pipeline --accept-unconverged``: the solving stages get ``accept_unconverged``
+    (other stages nothing), without changing the caller's stage options."""
+    from types import SimpleNamespace
+
+    from nmsm.tools.pipeline.runner import _with_accept_unconverged
+
+    def stage(name: str, tool: str) -> SimpleNamespace:
+        return SimpleNamespace(name=name, kind=SimpleNamespace(tool_element=tool))
+
+    spec = SimpleNamespace(stages=[stage("jmp", "JointModelPersonalizationTool"),
+                                   stage("analysis", "ModelAnalysisTool"),
+                                   stage("gcp", "GroundContactPersonalizationTool"),
+                                   stage("to", "TrackingOptimizationTool")])
+    given = {"gcp": {"max_iterations": 5}}
+    assert _with_accept_unconverged(spec, given, False) is given
+    options = _with_accept_unconverged(spec, given, True)
+    assert options == {"jmp": {"accept_unconverged": True}, "to": {"accept_unconverged": True},
+                       "gcp": {"max_iterations": 5, "accept_unconverged": True}}
+    assert given == {"gcp": {"max_iterations": 5}}
