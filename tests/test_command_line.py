@@ -84,9 +84,6 @@ def fast_parser():
     parser.add_argument("--progress", type=float, default=0.0)
     parser.add_subparsers().add_parser("done").set_defaults(func=lambda args: 0)
     return parser
-
-
-cli.build_parser = fast_parser
 """
 
 
@@ -95,7 +92,8 @@ def test_ctrl_c_after_the_command_finished_keeps_its_exit_status(tmp_path: Path)
     closing, threads joining) leaves the exit status 0, not death by SIGINT."""
     import os
 
-    script = FAST_PARSER + ("import os, signal, sys, time\n"
+    script = FAST_PARSER + ("cli.build_parser = fast_parser\n"
+                            "import os, signal, sys, time\n"
                             "sys.argv = ['nmsm', 'done']\n"
                             "code = cli.main()\n"
                             "os.kill(os.getpid(), signal.SIGINT)\n"
