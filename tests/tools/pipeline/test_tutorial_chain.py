@@ -63,17 +63,18 @@ def test_subject3_chain_equals_stages_one_by_one(shared_data: Path, tmp_path: Pa
     from nmsm.tools.pipeline.runner import RAN, UP_TO_DATE, run_pipeline_file
 
     files = _settings(shared_data)
-    run = run_pipeline_file(_pipeline(tmp_path, files), log=None)
+    # the tutorials as they are: GCP V1 stops at its evaluation limit (as the original did)
+    run = run_pipeline_file(_pipeline(tmp_path, files), log=None, accept_unconverged=True)
     assert [s.status for s in run.stages] == [RAN] * 4
     assert run.stage("ncp").wired["mtp_results_directory"] == "mtp_results from stage 'mtp'"
     chained = tmp_path / "chained"
 
     alone = tmp_path / "alone"
-    jmp = run_jmp(files["jmp"], results_directory=alone / "jmp", quiet=True)
-    run_mtp(files["mtp"], results_directory=alone / "mtp")
+    jmp = run_jmp(files["jmp"], results_directory=alone / "jmp", quiet=True, accept_unconverged=True)
+    run_mtp(files["mtp"], results_directory=alone / "mtp", accept_unconverged=True)
     ncp_file = _ncp_settings_on(alone / "mtp", files["ncp"], tmp_path / "ncp_alone.xml")
-    run_ncp(ncp_file, results_directory=alone / "ncp", print_level=0)
-    run_gcp(files["gcp"], results_directory=alone / "gcp")
+    run_ncp(ncp_file, results_directory=alone / "ncp", print_level=0, accept_unconverged=True)
+    run_gcp(files["gcp"], results_directory=alone / "gcp", accept_unconverged=True)
 
     # JMP: the same personalized model
     assert (chained / "jmp" / jmp.output_model.name).read_text() == jmp.output_model.read_text()
@@ -101,5 +102,5 @@ def test_subject3_chain_equals_stages_one_by_one(shared_data: Path, tmp_path: Pa
         np.testing.assert_allclose([s.spring_constant for s in x.springs], [s.spring_constant for s in y.springs],
                                    rtol=1e-8)
     # run again: every stage up to date
-    again = run_pipeline_file(tmp_path / "pipeline.xml", log=None)
+    again = run_pipeline_file(tmp_path / "pipeline.xml", log=None, accept_unconverged=True)
     assert [s.status for s in again.stages] == [UP_TO_DATE] * 4
