@@ -25,6 +25,8 @@ from pathlib import Path
 
 from lxml import etree
 
+from nmsm.io.xml_input import xml_parser
+
 #: foot -> (surface name, is_left_foot, plate number, hindfoot body, marker prefix)
 SURFACES = {
     "right": ("Right foot", False, 2, "calcn_r", "R_"),
@@ -43,7 +45,7 @@ def _child(parent: etree._Element, tag: str, text: str | None = None) -> etree._
 
 def model_with_left_toe_markers(model_file: Path, out: Path) -> Path:
     """Copy ``model_file`` to ``out`` with :data:`MIRRORED_MARKERS` added (module docstring)."""
-    tree = etree.parse(str(model_file), etree.XMLParser(remove_blank_text=True))
+    tree = etree.parse(str(model_file), xml_parser(huge_tree=True, remove_blank_text=True))
     markers = tree.find(".//MarkerSet/objects")
     existing = {m.get("name"): m for m in markers.findall("Marker")}
     for name, source in MIRRORED_MARKERS.items():
@@ -90,7 +92,7 @@ def write_two_feet_tutorial(tutorial: str | Path, folder: str | Path, *, feet: S
     folder.mkdir(parents=True, exist_ok=True)
     model = model_with_left_toe_markers(tutorial / "bodyModel.osim", folder / "bodyModel.osim")
     source = tutorial / "CompletedSettingsFiles" / f"GCPSettingsV{version}.xml"
-    tree = etree.parse(str(source), etree.XMLParser(remove_blank_text=True))
+    tree = etree.parse(str(source), xml_parser(remove_blank_text=True))
     tool = tree.find("GroundContactPersonalizationTool")
     tool.find("results_directory").text = str(folder / "results")
     tool.find("input_directory").text = str(tutorial / "preprocessed")
