@@ -133,3 +133,21 @@ def test_an_external_dtd_is_not_fetched(shared_data: Path, tmp_path: Path) -> No
         read_settings_document(settings)
     assert SECRET not in str(caught.value) and str(settings) in str(caught.value)
     assert "external DTD" in str(caught.value)
+
+
+def test_every_parser_of_nmsm_is_the_safe_one() -> None:
+    """No module parses XML with lxml's default parser, builds its own ``XMLParser`` or uses
+    the standard library's XML modules (nmsm.io.xml_input.xml_parser is the one parser)."""
+    import nmsm
+
+    root = Path(nmsm.__file__).parent
+    offenders = []
+    for path in sorted(root.rglob("*.py")):
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            code = line.split("#")[0]
+            calls = re.findall(r"etree\.(?:parse|fromstring|XML|iterparse)\((.*)", code)
+            if any("xml_parser(" not in call for call in calls) or (
+                    "XMLParser(" in code and path.name != "xml_input.py") or re.search(
+                    r"\bimport xml\.|\bfrom xml\.|minidom|(?<!l)xml\.etree", code):
+                offenders.append(f"{path.relative_to(root)}:{number}: {line.strip()}")
+    assert not offenders, "\n".join(offenders)
