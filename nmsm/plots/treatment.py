@@ -186,9 +186,11 @@ def _tracked_folder(folder: Path) -> Path | None:
     """The tracked-quantities folder named in the settings copy of a results folder, when it exists."""
     from lxml import etree
 
+    from nmsm.io.xml_input import xml_parser
+
     for settings in sorted(folder.glob("*.xml")):
         try:
-            root = etree.parse(str(settings)).getroot()
+            root = etree.parse(str(settings), xml_parser()).getroot()
         except (etree.XMLSyntaxError, OSError):
             continue
         for element in root.iter("tracked_quantities_directory"):

@@ -25,8 +25,9 @@ def _jmp(shared_data: Path, tmp_path: Path) -> tuple[Callable[..., object], str]
     from nmsm.tools.jmp.run import run_settings
 
     settings = shared_data / "jmp/toy_simple_arm/ToySettingsFile.xml"
-    return (lambda out, **kw: run_settings(settings, results_directory=out, quiet=True, max_function_evaluations=2,
-                                           **kw)), "*.osim"
+    limits = {"function_tolerance": 1e-30, "step_tolerance": 1e-30, "optimality_tolerance": 1e-30,
+              "max_function_evaluations": 3}  # tolerances it cannot reach within 3 evaluations
+    return (lambda out, **kw: run_settings(settings, results_directory=out, quiet=True, **limits, **kw)), "*.osim"
 
 
 def _mtp(shared_data: Path, tmp_path: Path) -> tuple[Callable[..., object], str]:
@@ -123,8 +124,10 @@ def test_nmsm_run_exits_1_and_accepts_with_the_option(shared_data: Path, tmp_pat
         shutil.copy(toy / name, tmp_path / name)
     settings = tmp_path / "ToySettingsFile.xml"
     text = settings.read_text()
-    settings.write_text(text.replace("<JMPTaskList>", "<max_function_evaluations>2</max_function_evaluations>"
-                                                      "<JMPTaskList>", 1))
+    limits = "".join(f"<{name}>{value}</{name}>" for name, value in (
+        ("function_tolerance", "1e-30"), ("step_tolerance", "1e-30"), ("optimality_tolerance", "1e-30"),
+        ("max_function_evaluations", "3")))
+    settings.write_text(text.replace("<JMPTaskList>", limits + "<JMPTaskList>", 1))
     out = tmp_path / "out"
     assert main(["run", str(settings), "-o", str(out)]) == 1
     assert "last_iterate" in capsys.readouterr().err
