@@ -19,7 +19,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.tools.treatment.term_bases import DiscreteCost
+from nmsm.core.ocp import DiscreteCost
 
 AMPLITUDES = ("rms", "mean", "peak")
 

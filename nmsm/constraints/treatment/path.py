@@ -16,8 +16,8 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.signals import SIGNALS
-from nmsm.tools.treatment.term_bases import PathConstraint
+from nmsm.core.signals import SIGNALS
+from nmsm.core.ocp import PathConstraint
 
 
 @attrs.frozen(kw_only=True)

@@ -31,7 +31,7 @@ from nmsm.core.problem import Solution
 from nmsm.core.results import ResultsDirectory
 from nmsm.errors import InputError, SolverError
 from nmsm.io.layout import trial_table_folders
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
 from nmsm.tools.ncp.initial_guess import initial_guess
 from nmsm.tools.ncp.loading import NcpSetup, load_ncp

@@ -17,10 +17,11 @@ import attrs
 import numpy as np
 
 from nmsm.core.registry import get_registry
-from nmsm.core.term import Term, build_terms
+from nmsm.core.term import Term
+from nmsm.core.registry import build_terms
 from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
-from nmsm.tools.treatment.bounds import RangeRule, check_guess_within, range_bounds
+from nmsm.core.bounds import RangeRule, check_guess_within, range_bounds
 from nmsm.tools.treatment.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
 from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files

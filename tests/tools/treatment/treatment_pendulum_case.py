@@ -9,7 +9,7 @@ import numpy as np
 
 from nmsm.controllers.torque import TorqueController
 from nmsm.examples.pendulum import Pendulum
-from nmsm.tools.treatment.bounds import RangeRule, range_bounds
+from nmsm.core.bounds import RangeRule, range_bounds
 from nmsm.tools.treatment.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
