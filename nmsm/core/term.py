@@ -496,8 +496,13 @@ class CostTerm(Term):
         raise NotImplementedError(f"{type(self).__name__}.quantity")
 
     def normalized(self, ctx: Any) -> Any:
-        """``(quantity - error_center) / max_allowable_error``; override only for non-standard forms."""
-        return (self.quantity(ctx) - self.error_center) / self.max_allowable_error
+        """``(quantity - error_center) / max_allowable_error``; a quantity given as a tuple of
+        blocks (reduced one by one by the tool, e.g. one per foot) gives the tuple of normalized
+        blocks. Override only for non-standard forms."""
+        quantity = self.quantity(ctx)
+        if isinstance(quantity, tuple):
+            return tuple((block - self.error_center) / self.max_allowable_error for block in quantity)
+        return (quantity - self.error_center) / self.max_allowable_error
 
     def residuals(self, ctx: TermContext) -> Any:
         """Residuals whose squared sum is this term's objective contribution."""
