@@ -289,6 +289,9 @@ class Term:
     kind: ClassVar[str] = ""
     #: settings element aliases: alias -> field name
     aliases: ClassVar[dict[str, str]] = {}
+    #: settings elements -> text of a valid term, for :func:`nmsm.testing.check_term` (names of
+    #: its synthetic problem where the term names model parts)
+    check_example: ClassVar[Mapping[str, str]] = {}
 
     is_enabled: bool = True
     name: str | None = None
