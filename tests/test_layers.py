@@ -4,13 +4,13 @@ Read from the source with :mod:`ast` (nothing is imported). Every ``import`` cou
 level or inside a function, because both run; imports under ``if TYPE_CHECKING:`` never run
 and are left out. Layers, lowest first (docs/architecture.md, "Layers"):
 
-    errors, hookspecs  <-  io  <-  core  <-  model  <-  plugins  <-  tools  <-  cli, report, plots
+    errors, hookspecs  <-  io  <-  core  <-  model, interop  <-  plugins  <-  tools  <-  cli, report, plots
 
 A module may import its own layer and the layers below it. The root package ``nmsm`` (the
 facade ``nmsm.run``, ``nmsm.run_pipeline``, ``__version__``) is imported before any of its
 modules, so importing it is no dependency; it stands above every layer. Plugins (``nmsm.terms``,
 ``nmsm.constraints``, ``nmsm.controllers``, ``nmsm.modifiers``) and ``plugins_example/`` stand
-on the public API only: ``nmsm.core``, ``nmsm.model``, ``nmsm.io``, ``nmsm.errors``.
+on the public API only: ``nmsm.core``, ``nmsm.model``, ``nmsm.interop``, ``nmsm.io``, ``nmsm.errors``.
 """
 
 from __future__ import annotations
@@ -32,12 +32,12 @@ LAYERS: dict[str, int] = {
     "nmsm.opensim_bridge": 1,
     "nmsm.core": 2,
     "nmsm.model": 3,
+    "nmsm.interop": 3,
     "nmsm.terms": 4,
     "nmsm.constraints": 4,
     "nmsm.controllers": 4,
     "nmsm.modifiers": 4,
     "nmsm.tools": 5,
-    "nmsm.interop": 5,
     "nmsm.examples": 5,
     "nmsm.__main__": 6,
     "nmsm.cli": 6,
@@ -45,9 +45,10 @@ LAYERS: dict[str, int] = {
     "nmsm.report": 6,
     "nmsm.plots": 6,
     "nmsm.testing": 6,
+    "nmsm.results": 6,
 }
 PLUGIN_PARTS = ("nmsm.terms", "nmsm.constraints", "nmsm.controllers", "nmsm.modifiers")
-PUBLIC_API = ("nmsm.core", "nmsm.model", "nmsm.io", "nmsm.errors", "nmsm.hookspecs")
+PUBLIC_API = ("nmsm.core", "nmsm.model", "nmsm.interop", "nmsm.io", "nmsm.errors", "nmsm.hookspecs")
 
 #: Known imports of a higher layer still to be removed (issue 29): the muscle and synergy
 #: controllers build their muscle model through the treatment tool; JMP and NCP runs draw
