@@ -105,8 +105,8 @@ def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str
     would hold, without ``type`` and ``is_enabled``; default: the class's ``check_example``);
     fields missing from it take :data:`PENDULUM_VALUES` (and required ones
     :data:`PLACEHOLDER_VALUES`). A required field still without a value stops the checks
-    after the declaration (``report.not_built`` says which). ``tool``: the tool to check for (default: a treatment tool the
-    class accepts, else its first tool).
+    after the declaration (``report.not_built`` says which). ``tool``: the tool to check for
+    (default: a treatment tool the class accepts, else its first tool).
     """
     report = TermCheckReport(cls)
     name = f"{getattr(cls, '__module__', '?')}.{getattr(cls, '__qualname__', cls)}"
@@ -186,7 +186,8 @@ def _check_settings(cls: type, name: str, elements: dict[str, str], report: Term
             cls.from_spec(_spec(cls, {**elements, **wrong}))
         except InputError:
             continue
-        raise TermCheckError(f"{name}: the settings elements {wrong} were accepted (expected an InputError naming them)")
+        raise TermCheckError(f"{name}: the settings elements {wrong} were accepted "
+                             "(expected an InputError naming them)")
     report.passed.append("bad elements refused")
     return terms
 
@@ -227,7 +228,9 @@ def _check_on_pendulum(cls: type, name: str, term: Term, tool: str, report: Term
     direction = rng.standard_normal(x0.size)
     direction /= np.linalg.norm(direction)
     h = 1e-6
-    fd = (np.asarray(f(x0 + h * direction, values)).ravel() - np.asarray(f(x0 - h * direction, values)).ravel()) / (2 * h)
+    forward = np.asarray(f(x0 + h * direction, values)).ravel()
+    backward = np.asarray(f(x0 - h * direction, values)).ravel()
+    fd = (forward - backward) / (2 * h)
     ad = np.asarray(jac(x0, values)) @ direction
     scale = max(1.0, float(np.max(np.abs(ad), initial=0.0)))
     if not np.allclose(ad, fd, rtol=1e-4, atol=1e-5 * scale):

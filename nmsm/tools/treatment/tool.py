@@ -37,8 +37,8 @@ CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMu
 
 
 #: threads of the per-point model functions (CasADi ``map`` with ``thread``
-#: parallelization; :data:`nmsm.core.threads.SOLVER_THREADS`). Same iterates as one thread;
-#: measured 2026-11-26: synergy TO V4 29.2 -> 20.4 s, torque TO V2 9.5 -> 7.0 s (docs/treatment.md).
+#: parallelization; :data:`nmsm.core.threads.SOLVER_THREADS`): the same iterates as one thread
+#: (timings: docs/treatment.md).
 DEFAULT_PARALLEL = SOLVER_THREADS
 
 
