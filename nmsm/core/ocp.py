@@ -311,10 +311,11 @@ class OcpContext(OcpGrid, Protocol):
         """(K, m) time derivative (1/s) of (K, m) collocation values, through each mesh
         interval's polynomial on its collocation points.
 
-        Safe to minimise for a quantity continuous across mesh intervals (states, a
-        controller's controls). Not for accelerations or other quantities that jump between
-        intervals: the derivative inside each interval ignores the jumps, so minimising it
-        can raise the true derivative while the solver reports success.
+        Safe to minimise only for quantities continuous across mesh intervals: the states
+        (coordinates and speeds of ``<states_coordinate_list>``). Quantities known only at
+        the collocation points - accelerations, controls - may jump from one interval to the
+        next, which this derivative does not see: minimising it can raise the true derivative
+        while the solver reports success.
         """
 
     # ---- name checks (raise InputError naming the term's settings file and line) ----
