@@ -56,11 +56,8 @@ PUBLIC_API = ("nmsm.core", "nmsm.model", "nmsm.interop", "nmsm.io", "nmsm.errors
 #: write the HTML report. An edge that disappears must be removed from here too, so the list
 #: only shrinks.
 KNOWN_UPWARD: frozenset[tuple[str, str]] = frozenset({
-    ("nmsm.controllers.muscle", "nmsm.tools.treatment.controller_setup"),
     ("nmsm.controllers.muscle", "nmsm.tools.treatment.muscles"),
-    ("nmsm.controllers.synergy", "nmsm.tools.treatment.controller_setup"),
     ("nmsm.controllers.synergy", "nmsm.tools.treatment.muscles"),
-    ("nmsm.controllers.torque", "nmsm.tools.treatment.controller_setup"),
     ("nmsm.tools.jmp.run", "nmsm.plots.jmp"),
     ("nmsm.tools.ncp.run", "nmsm.plots.ncp"),
     ("nmsm.tools.pipeline.cli", "nmsm.report.html"),

@@ -95,7 +95,7 @@ class Controller:
     @classmethod
     def from_settings(cls, settings: Any, setup: Any) -> Controller:
         """Build from the element's parsed settings and the tool's
-        :class:`nmsm.tools.treatment.controller_setup.ControllerSetup`."""
+        :class:`nmsm.core.controller_setup.ControllerSetup`."""
         raise NotImplementedError(f"{cls.__name__}.from_settings")
 
     # ---- declaration -------------------------------------------------------------------

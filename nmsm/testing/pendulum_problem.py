@@ -14,7 +14,7 @@ import numpy as np
 
 from nmsm.core.bounds import RangeRule, range_bounds
 from nmsm.examples.pendulum import Pendulum
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.references import ReferenceSplines

@@ -22,7 +22,7 @@ from nmsm.core.registry import build_terms
 from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
 from nmsm.core.bounds import RangeRule, check_guess_within, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
 from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files
 from nmsm.tools.treatment.model_interface import TreatmentModel

@@ -22,7 +22,7 @@ from nmsm.modifiers.joint_frame import ApplyJointFrameOrientationParameter
 from nmsm.terms.treatment.inverse_dynamics import InverseDynamicsLoadTracking
 from nmsm.terms.treatment.kinematics import GeneralizedCoordinateTracking
 from nmsm.core.bounds import RangeRule, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 from nmsm.tools.treatment.modifiers import ModificationTarget
