@@ -387,7 +387,11 @@ class GridView:
 
 
 class TreatmentContext(GridView):
-    """What terms receive: the collocation-point view, terminal views and problem-wide data."""
+    """What terms receive: the collocation-point view, terminal views and problem-wide data.
+
+    Implements :class:`nmsm.core.ocp.OcpContext`, the public protocol a term is written
+    against (every quantity with its units and shapes).
+    """
 
     def __init__(self, quantities: ContextQuantities) -> None:
         super().__init__(quantities, quantities.trajectory.integration_grid)
