@@ -47,7 +47,32 @@ def _plugins(args: argparse.Namespace) -> int:
     except BrokenPipeError:  # `nmsm plugins | head`: the reader has what it wanted
         _discard_stdout()
         return 0
-    return 1 if report.problems else 0
+    failed = _check_terms(items) if getattr(args, "check", False) else 0
+    return 1 if report.problems or failed else 0
+
+
+def _check_terms(items: Any) -> int:
+    """``nmsm.testing.check_term`` on each registered term class, one line each; the number
+    that failed."""
+    from nmsm.testing import TermCheckError, check_term
+
+    print()
+    failed = 0
+    seen: set[type] = set()
+    for it in items:
+        if it.kind not in ("cost", "constraint") or it.cls in seen:
+            continue
+        seen.add(it.cls)
+        try:
+            result = check_term(it.cls)
+        except TermCheckError as exc:
+            failed += 1
+            print(f"FAILED  {it.kind} {it.name}: {exc}")
+            continue
+        extra = f" (not built: {result.not_built})" if result.not_built else ""
+        print(f"ok      {it.kind} {it.name}: {', '.join(result.passed)}{extra}")
+    print(f"\n{len(seen) - failed} of {len(seen)} term classes pass nmsm.testing.check_term")
+    return failed
 
 
 def _discard_stdout() -> None:
@@ -84,4 +109,6 @@ def register(subparsers: Any) -> None:
         help="list every registered term, constraint, controller, modifier and contact model, and broken plugins",
     )
     p.add_argument("--kind", choices=list(KINDS), help="only this kind")
+    p.add_argument("--check", action="store_true",
+                   help="also run nmsm.testing.check_term on every registered cost and constraint term")
     p.set_defaults(func=_plugins)

@@ -54,6 +54,20 @@ class ModelError(InputError):
     """An OpenSim model that nmsm cannot represent or that is inconsistent."""
 
 
+class TermValueError(ValueError):
+    """A term field's value is out of its range (raised by a term's field validators).
+
+    ``field`` is the field (settings element) at fault and ``expected`` what it accepts, so
+    the settings reader can name the element, its line and the accepted values in the
+    :class:`InputError` it raises.
+    """
+
+    def __init__(self, message: str, *, field: str, expected: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+        self.expected = expected
+
+
 class RegistryError(NmsmError):
     """A plugin problem: duplicate names, unknown names, bad registrations."""
 

@@ -46,7 +46,7 @@ import numpy as np
 
 from nmsm.core.plugin_bases import ControlSpec, Controller, StateSpec
 from nmsm.interop.moco_trajectory import MocoColumns, muscle_activation_path, muscle_control_path
-from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
+from nmsm.core.controller_setup import ControllerSetup, name_list, setting
 from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
 
 PREFIX = "activation:"

@@ -37,7 +37,7 @@ import numpy as np
 from nmsm.core.plugin_bases import ControlSpec, Controller
 from nmsm.interop.moco_trajectory import MocoColumns, muscle_control_path
 from nmsm.io.storage import Table
-from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
+from nmsm.core.controller_setup import ControllerSetup, name_list, setting
 from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
 
 PREFIX = "synergy:"

@@ -22,9 +22,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from nmsm.core.plugin_bases import ControlSpec, Controller
+from nmsm.core.bounds import RangeRule, range_bounds
 from nmsm.interop.moco_trajectory import MocoColumns, torque_actuator_path
-from nmsm.tools.treatment.bounds import RangeRule, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup, name_list, setting
+from nmsm.core.controller_setup import ControllerSetup, name_list, setting
 
 PREFIX = "torque:"
 

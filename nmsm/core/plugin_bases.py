@@ -95,7 +95,7 @@ class Controller:
     @classmethod
     def from_settings(cls, settings: Any, setup: Any) -> Controller:
         """Build from the element's parsed settings and the tool's
-        :class:`nmsm.tools.treatment.controller_setup.ControllerSetup`."""
+        :class:`nmsm.core.controller_setup.ControllerSetup`."""
         raise NotImplementedError(f"{cls.__name__}.from_settings")
 
     # ---- declaration -------------------------------------------------------------------
@@ -178,6 +178,16 @@ class ContactModel:
     force_labels: tuple[str, str, str] = ("", "", "")
     moment_labels: tuple[str, str, str] = ("", "", "")
     point_labels: tuple[str, str, str] = ("", "", "")
+    #: True when ``point_function``'s moment is the surface's own moment about its floor point
+    #: (GCP's convention for the foot's ground reaction); False when the foot's moment about
+    #: the ground origin comes from the loads applied to the bodies
+    moment_about_floor_point: ClassVar[bool] = False
+
+    @property
+    def hindfoot_body(self) -> str | None:
+        """The foot's body this contact belongs to (the first load body unless the model says
+        otherwise), which ``<hindfoot_body>`` of the treatment terms names."""
+        return self.load_bodies[0] if self.load_bodies else None
 
     @classmethod
     def discover(cls, setup: Any) -> list[ContactModel]:

@@ -32,15 +32,17 @@ import os
 import re
 import sys
 import warnings
-import weakref
 from collections.abc import Callable, Iterable
 from functools import cache
 from importlib import metadata
+from typing import Any
 
 import attrs
 import pluggy
 
-from nmsm.errors import RegistryError
+from nmsm.core.origins import origin_of, record_origin  # noqa: F401  (origin_of: part of this module's API)
+from nmsm.core.term import Term, TermSpec, _location, parse_bool, term_class_problems
+from nmsm.errors import InputError, RegistryError
 from nmsm.hookspecs import ENTRY_POINT_GROUP, PROJECT_NAME, NmsmHookSpecs
 
 #: kind -> hook name
@@ -93,21 +95,6 @@ class RegisteredItem:
         return doc.splitlines()[0] if doc else ""
 
 
-#: class -> (distribution, version) of every class a registry holds (messages about a term's code)
-_ORIGINS: weakref.WeakKeyDictionary[type, tuple[str, str]] = weakref.WeakKeyDictionary()
-
-
-def origin_of(cls: type) -> tuple[str, str] | None:
-    """``(distribution, version)`` that registered ``cls`` (or a class it derives from), if any."""
-    for klass in cls.__mro__:
-        try:
-            found = _ORIGINS.get(klass)
-        except TypeError:
-            continue
-        if found is not None:
-            return found
-    return None
-
 
 def _split_env(name: str) -> list[str]:
     return [p.strip() for p in os.environ.get(name, "").split(",") if p.strip()]
@@ -155,7 +142,7 @@ class Registry:
         if item.kind == "controller":
             self._check_controller_element(item)
         same.append(item)
-        _ORIGINS[item.cls] = (item.distribution, item.version)
+        record_origin(item.cls, item.distribution, item.version)
 
     def _check_controller_element(self, item: RegisteredItem) -> None:
         """A controller's settings element selects it: two controllers for the same element
@@ -352,8 +339,6 @@ def _check_class(kind: str, obj: object) -> tuple[str, frozenset[str], list[str]
                 text += f" (it is a {other.__name__}: return it from {KINDS[other_kind]}())"
                 break
         return "", frozenset(), [text]
-    from nmsm.core.term import Term, term_class_problems
-
     if issubclass(obj, Term):
         problems = term_class_problems(obj)
         if problems:
@@ -512,3 +497,37 @@ def classes_in_package(package_name: str, base: type) -> list[type]:
             ):
                 found.append(obj)
     return found
+
+
+def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> list[Term]:
+    """Registered term instances for the enabled specs of ``tool``, in declaration order.
+
+    A term without ``<is_enabled>``, or with an empty one, is not used (the original's default,
+    false), with a warning; an ``<is_enabled>`` other than true/false, and unknown or
+    disallowed type names, raise :class:`InputError` naming the file and line.
+    """
+    registry = registry or get_registry()
+    out: list[Term] = []
+    for spec in specs:
+        tag = "RCNLCostTerm" if spec.kind == "cost" else "RCNLConstraintTerm"
+        where = _location(spec.source.file, spec.source.line)
+        text = spec.fields.get("is_enabled")
+        if text is None or not text.strip():  # the original's default: false (spec settings-xml.md)
+            state = "has no <is_enabled>" if text is None else "has an empty <is_enabled>"
+            warnings.warn(f"{where}<{tag}> '{spec.type}' {state}: not used "
+                          f"(write <is_enabled>true</is_enabled>)", stacklevel=2)
+            continue
+        try:
+            enabled = parse_bool(text)
+        except ValueError as exc:
+            raise InputError(f"<{tag}> '{spec.type}': <is_enabled> is '{text}'", file=spec.source.file,
+                             line=spec.field_lines.get("is_enabled", spec.source.line), element="<is_enabled>",
+                             expected="true or false") from exc
+        if not enabled:
+            continue
+        try:
+            cls = registry.get(spec.kind, spec.type, tool)
+        except RegistryError as exc:
+            raise InputError(str(exc), file=spec.source.file, line=spec.source.line, element="<type>") from exc
+        out.extend(cls.from_spec(spec))
+    return out

@@ -11,7 +11,7 @@ contribution to the objective.
 Writing a term::
 
     @attrs.frozen(kw_only=True)
-    class GeneralizedCoordinateTracking(ContinuousTerm):
+    class GeneralizedCoordinateTracking(ContinuousCost):  # nmsm.core.ocp.ContinuousCost
         \"\"\"Tracks one coordinate: q_exp - q (rad or m).\"\"\"
         type: ClassVar[str] = "generalized_coordinate_tracking"
         tools: ClassVar[frozenset[str]] = frozenset({"TO", "VO", "DO"})
@@ -37,43 +37,9 @@ from typing import Any, ClassVar, Protocol
 
 import attrs
 
-from nmsm.errors import InputError, NmsmError, RegistryError
-
-
-@attrs.frozen
-class SourceRef:
-    """Where a term was declared: settings file and line."""
-
-    file: str | None = None
-    line: int | None = None
-
-
-@attrs.frozen
-class TermSpec:
-    """A term as read from settings XML, before it is matched to a registered class.
-
-    ``fields`` maps each child element name to its text (stripped); ``type`` and
-    ``is_enabled`` are kept in ``fields`` too.
-    """
-
-    kind: str  # "cost" or "constraint"
-    type: str
-    fields: Mapping[str, str]
-    source: SourceRef = SourceRef()
-    field_lines: Mapping[str, int] = attrs.field(factory=dict)
-
-
-class TermValueError(ValueError):
-    """A term field's value is out of its range (raised by field validators).
-
-    ``field`` is the field (settings element) at fault and ``expected`` what it accepts, so
-    :meth:`Term.from_spec` can name the element, its line and the accepted values.
-    """
-
-    def __init__(self, message: str, *, field: str, expected: str | None = None) -> None:
-        super().__init__(message)
-        self.field = field
-        self.expected = expected
+from nmsm.core.origins import origin_of
+from nmsm.io.term_spec import SourceRef, TermSpec
+from nmsm.errors import InputError, NmsmError, RegistryError, TermValueError
 
 
 class TermContext(Protocol):
@@ -260,8 +226,6 @@ class TermCodeError(RegistryError):
         if term.source.file:
             where = term.source.file + (f":{term.source.line}" if term.source.line is not None else "") + ": "
         owner = _qualified(cls)
-        from nmsm.core.registry import origin_of
-
         origin = origin_of(cls)
         if origin is not None and origin[0] != "nmsm":
             owner += f" from distribution '{origin[0]}' {origin[1]}"
@@ -325,6 +289,9 @@ class Term:
     kind: ClassVar[str] = ""
     #: settings element aliases: alias -> field name
     aliases: ClassVar[dict[str, str]] = {}
+    #: settings elements -> text of a valid term, for :func:`nmsm.testing.check_term` (names of
+    #: its synthetic problem where the term names model parts)
+    check_example: ClassVar[Mapping[str, str]] = {}
 
     is_enabled: bool = True
     name: str | None = None
@@ -532,8 +499,13 @@ class CostTerm(Term):
         raise NotImplementedError(f"{type(self).__name__}.quantity")
 
     def normalized(self, ctx: Any) -> Any:
-        """``(quantity - error_center) / max_allowable_error``; override only for non-standard forms."""
-        return (self.quantity(ctx) - self.error_center) / self.max_allowable_error
+        """``(quantity - error_center) / max_allowable_error``; a quantity given as a tuple of
+        blocks (reduced one by one by the tool, e.g. one per foot) gives the tuple of normalized
+        blocks. Override only for non-standard forms."""
+        quantity = self.quantity(ctx)
+        if isinstance(quantity, tuple):
+            return tuple((block - self.error_center) / self.max_allowable_error for block in quantity)
+        return (quantity - self.error_center) / self.max_allowable_error
 
     def residuals(self, ctx: TermContext) -> Any:
         """Residuals whose squared sum is this term's objective contribution."""
@@ -562,39 +534,3 @@ class ConstraintTerm(Term):
     def bounded(self, ctx: TermContext) -> tuple[Any, Any, Any]:
         """``(expression, lower, upper)`` after the tool's scaling."""
         return ctx.reduce_constraint(self, self.value(ctx))
-
-
-def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> list[Term]:
-    """Registered term instances for the enabled specs of ``tool``, in declaration order.
-
-    A term without ``<is_enabled>``, or with an empty one, is not used (the original's default,
-    false), with a warning; an ``<is_enabled>`` other than true/false, and unknown or
-    disallowed type names, raise :class:`InputError` naming the file and line.
-    """
-    from nmsm.core.registry import get_registry
-
-    registry = registry or get_registry()
-    out: list[Term] = []
-    for spec in specs:
-        tag = "RCNLCostTerm" if spec.kind == "cost" else "RCNLConstraintTerm"
-        where = _location(spec.source.file, spec.source.line)
-        text = spec.fields.get("is_enabled")
-        if text is None or not text.strip():  # the original's default: false (spec settings-xml.md)
-            state = "has no <is_enabled>" if text is None else "has an empty <is_enabled>"
-            warnings.warn(f"{where}<{tag}> '{spec.type}' {state}: not used "
-                          f"(write <is_enabled>true</is_enabled>)", stacklevel=2)
-            continue
-        try:
-            enabled = parse_bool(text)
-        except ValueError as exc:
-            raise InputError(f"<{tag}> '{spec.type}': <is_enabled> is '{text}'", file=spec.source.file,
-                             line=spec.field_lines.get("is_enabled", spec.source.line), element="<is_enabled>",
-                             expected="true or false") from exc
-        if not enabled:
-            continue
-        try:
-            cls = registry.get(spec.kind, spec.type, tool)
-        except RegistryError as exc:
-            raise InputError(str(exc), file=spec.source.file, line=spec.source.line, element="<type>") from exc
-        out.extend(cls.from_spec(spec))
-    return out

@@ -54,31 +54,6 @@ def excitations_from_activations(time: np.ndarray, activation: np.ndarray, time_
     return np.clip(excitation, 0.0, 1.0), float(clipped.max(initial=0.0))
 
 
-def activations_from_excitations(time: np.ndarray, excitation: np.ndarray, time_constant: np.ndarray,
-                                 nonlinearity: np.ndarray, start: np.ndarray) -> np.ndarray:
-    """Activations (T, M) by integrating the activation dynamics (RK4 on ``time``, the
-    excitation linear between samples) from neural activations ``start`` (M,)."""
-    tau_a = np.asarray(time_constant, dtype=float)
-    c2 = 1.0 / (hill.DEACTIVATION_RATIO * tau_a)
-    c1 = 1.0 / tau_a - c2
-
-    def f(n: np.ndarray, e: np.ndarray) -> np.ndarray:
-        return (c1 * e + c2) * (e - n)
-
-    n = np.zeros_like(excitation)
-    n[0] = start
-    for k in range(time.size - 1):
-        h = time[k + 1] - time[k]
-        e0, e1 = excitation[k], excitation[k + 1]
-        em = 0.5 * (e0 + e1)
-        k1 = f(n[k], e0)
-        k2 = f(n[k] + h / 2 * k1, em)
-        k3 = f(n[k] + h / 2 * k2, em)
-        k4 = f(n[k] + h * k3, e1)
-        n[k + 1] = n[k] + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return hill.activation_nonlinearity(n, np.asarray(nonlinearity)[None, :])
-
-
 def raw_emg(time: np.ndarray, excitation: np.ndarray, delays: Sequence[float], out_time: np.ndarray,
             seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Raw EMG (len(out_time), M) in mV and the channel gains (M,): channel ``m`` at time

@@ -215,7 +215,7 @@ def _foot_motion(time: np.ndarray, start: float, side: str, belt_speed: float) -
 def write_synthetic_gcp(folder: str | Path, truth: SyntheticTruth = SyntheticTruth(), *,
                         sides: Sequence[str] = ("r",), grid: tuple[int, int] = (5, 7)) -> SyntheticGcp:
     """Write the synthetic case into ``folder`` (created) and return its paths and truth."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.run import load_feet
     from nmsm.tools.gcp.state import GcpState

@@ -184,16 +184,6 @@ def walk(
     return Walk(Path(os.path.normpath(current.joinpath(*rest))), "/".join(spelled + rest), renamed, False)
 
 
-def match_case_insensitive(base: Path, relative: Path, kind: str = "any") -> Path | None:
-    """``base / relative`` with each missing component matched case-insensitively.
-
-    Returns the existing path (without ``..`` parts), or ``None``. Raises :class:`InputError`
-    when a component matches several entries that differ only in case.
-    """
-    found = walk(base, relative, kind)
-    return None if found is None else found.path
-
-
 def _describe(kind: str) -> str:
     return {"file": "an existing file", "dir": "an existing folder"}.get(kind, "an existing file or folder")
 

@@ -35,7 +35,7 @@ SOLVING_TOOLS: frozenset[str] = frozenset({
 
 def tool_element_name(settings_file: str | Path) -> str:
     """The tool element of a settings file (old schemas upgraded first)."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.tools.pipeline.native import native_tool_element
 
     native = native_tool_element(settings_file)  # the pipeline's own stages and pipeline files

@@ -19,7 +19,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.tools.treatment.term_bases import DiscreteCost
+from nmsm.core.ocp import DiscreteCost
 
 AMPLITUDES = ("rms", "mean", "peak")
 
@@ -41,6 +41,7 @@ class SynergyAmplitudeSymmetry(DiscreteCost):
 
     type: ClassVar[str] = "synergy_amplitude_symmetry"
     tools: ClassVar[frozenset[str]] = frozenset({"TO", "DO"})
+    check_example: ClassVar[dict[str, str]] = {"synergy_pairs": "RightSynergies_1:LeftSynergies_1"}
     synergy_pairs: str
     amplitude: str = "rms"
     #: set by from_spec: one term per pair

@@ -24,7 +24,7 @@ from nmsm.core.registry import build_registry
 from nmsm.core.term import ConstraintTerm, CostTerm, SourceRef, TermSpec
 from nmsm.errors import InputError, NmsmError, RegistryError
 from nmsm.hookspecs import hookimpl
-from nmsm.tools.treatment.term_bases import ContinuousCost, PathConstraint
+from nmsm.core.ocp import ContinuousCost, PathConstraint
 
 DIST = "check-plugin"
 

@@ -150,7 +150,7 @@ class _OnlyOffsets:
     ({"is_enabled": " "}, "has an empty <is_enabled>"),
 ])
 def test_a_term_without_a_usable_is_enabled_is_not_used_and_warned_about(given: dict, message: str) -> None:
-    from nmsm.core.term import build_terms
+    from nmsm.core.registry import build_terms
 
     specs = [TermSpec("cost", "offsets", {**given, "values": "1"}, SourceRef("s.xml", 21)),
              TermSpec("cost", "offsets", {"is_enabled": "true", "values": "2"}, SourceRef("s.xml", 25))]
@@ -162,7 +162,7 @@ def test_a_term_without_a_usable_is_enabled_is_not_used_and_warned_about(given: 
 
 
 def test_is_enabled_other_than_true_or_false_names_file_line_and_element() -> None:
-    from nmsm.core.term import build_terms
+    from nmsm.core.registry import build_terms
 
     spec = TermSpec("cost", "offsets", {"is_enabled": "yes"}, SourceRef("s.xml", 21), {"is_enabled": 22})
     with pytest.raises(InputError) as info:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.xml_input import element_text, set_element_text
 
 DOC = """<NMSMPipelineDocument Version="1.5.0">

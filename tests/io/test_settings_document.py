@@ -9,7 +9,7 @@ import pytest
 
 from nmsm.core.term import TermSpec
 from nmsm.errors import InputError
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 
 DOC = """<NMSMPipelineDocument Version="1.5.0">
   <TrackingOptimizationTool name="default">

@@ -11,7 +11,7 @@ import pytest
 
 from nmsm.cli import main
 from nmsm.errors import InputError
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 
 
 def _copy(shared_data: Path, folder: str, tmp_path: Path) -> Path:

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from nmsm.core.term import build_terms
+from nmsm.core.registry import build_terms
 from nmsm.errors import InputError
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings
 
 

@@ -45,7 +45,7 @@ def _poison(source: Path, target: Path, subset: str, reference: str) -> Path:
 
 def _readers() -> dict[str, tuple[str, Callable[[Path], object]]]:
     from nmsm.io.osimx import read_osimx
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.model.external_loads import read_external_loads
     from nmsm.model.osim import load_model
     from nmsm.tools.jmp.ik_settings import read_ik_settings
@@ -118,7 +118,7 @@ def test_the_parser_substitutes_no_entity(tmp_path: Path) -> None:
 def test_an_external_dtd_is_not_fetched(shared_data: Path, tmp_path: Path) -> None:
     """A ``<!DOCTYPE ... SYSTEM "file">`` declaring no entity in the file: the DTD is never
     loaded, and the file is refused."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
 
     dtd = tmp_path / "x.dtd"
     dtd.write_text(f'<!ENTITY xx "{SECRET}">', encoding="utf-8")

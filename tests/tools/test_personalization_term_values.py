@@ -261,7 +261,7 @@ def gcp_scene(tmp_path_factory):
     kinematic coefficients, spring constants, an electrical-center shift and a plate
     rotation. Returns (feet, state, context)."""
     from nmsm.examples.synthetic_gcp import write_synthetic_gcp
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.context import GcpContext
     from nmsm.tools.gcp.run import load_feet

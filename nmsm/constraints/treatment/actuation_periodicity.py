@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.term_bases import TerminalConstraint
+from nmsm.core.ocp import TerminalConstraint
 
 
 @attrs.frozen(kw_only=True)

@@ -15,7 +15,7 @@ import attrs
 import casadi as cs
 
 from nmsm.terms.treatment.center_of_pressure import require_floor_axis, require_time_ranges
-from nmsm.tools.treatment.term_bases import PathConstraint
+from nmsm.core.ocp import PathConstraint
 
 
 @attrs.frozen(kw_only=True)

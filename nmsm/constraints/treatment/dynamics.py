@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.term_bases import PathConstraint
+from nmsm.core.ocp import PathConstraint
 
 
 @attrs.frozen(kw_only=True)

@@ -16,8 +16,8 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.signals import SIGNALS
-from nmsm.tools.treatment.term_bases import PathConstraint
+from nmsm.core.signals import SIGNALS
+from nmsm.core.ocp import PathConstraint
 
 
 @attrs.frozen(kw_only=True)
@@ -53,108 +53,6 @@ class _BodyPath(_SignalPath):
 
 
 @attrs.frozen(kw_only=True)
-class GeneralizedCoordinateDeviation(_CoordinatePath):
-    """q - q_exp (rad or m)."""
-
-    type: ClassVar[str] = "generalized_coordinate_deviation"
-    family: ClassVar[str] = "generalized_coordinate"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class GeneralizedCoordinateValue(_CoordinatePath):
-    """q (rad or m)."""
-
-    type: ClassVar[str] = "generalized_coordinate_value"
-    family: ClassVar[str] = "generalized_coordinate"
-
-
-@attrs.frozen(kw_only=True)
-class GeneralizedSpeedDeviation(_CoordinatePath):
-    """q̇ - q̇_exp (rad/s or m/s)."""
-
-    type: ClassVar[str] = "generalized_speed_deviation"
-    family: ClassVar[str] = "generalized_speed"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class GeneralizedSpeedValue(_CoordinatePath):
-    """q̇ (rad/s or m/s)."""
-
-    type: ClassVar[str] = "generalized_speed_value"
-    family: ClassVar[str] = "generalized_speed"
-
-
-@attrs.frozen(kw_only=True)
-class GeneralizedAccelerationDeviation(_CoordinatePath):
-    """q̈ - q̈_exp (rad/s² or m/s²)."""
-
-    type: ClassVar[str] = "generalized_acceleration_deviation"
-    family: ClassVar[str] = "generalized_acceleration"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class GeneralizedAccelerationValue(_CoordinatePath):
-    """q̈ (rad/s² or m/s²)."""
-
-    type: ClassVar[str] = "generalized_acceleration_value"
-    family: ClassVar[str] = "generalized_acceleration"
-
-
-@attrs.frozen(kw_only=True)
-class MarkerPositionDeviation(_MarkerPath):
-    """p - p_exp on one axis (m)."""
-
-    type: ClassVar[str] = "marker_position_deviation"
-    family: ClassVar[str] = "marker_position"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class MarkerPositionValue(_MarkerPath):
-    """p on one axis (m)."""
-
-    type: ClassVar[str] = "marker_position_value"
-    family: ClassVar[str] = "marker_position"
-
-
-@attrs.frozen(kw_only=True)
-class MarkerVelocityDeviation(_MarkerPath):
-    """ṗ - ṗ_exp on one axis (m/s)."""
-
-    type: ClassVar[str] = "marker_velocity_deviation"
-    family: ClassVar[str] = "marker_velocity"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class MarkerVelocityValue(_MarkerPath):
-    """ṗ on one axis (m/s)."""
-
-    type: ClassVar[str] = "marker_velocity_value"
-    family: ClassVar[str] = "marker_velocity"
-
-
-@attrs.frozen(kw_only=True)
-class BodyOrientationDeviation(_BodyPath):
-    """θ - θ_exp about one axis (rad)."""
-
-    type: ClassVar[str] = "body_orientation_deviation"
-    family: ClassVar[str] = "body_orientation"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class BodyOrientationValue(_BodyPath):
-    """θ about one axis (rad)."""
-
-    type: ClassVar[str] = "body_orientation_value"
-    family: ClassVar[str] = "body_orientation"
-
-
-@attrs.frozen(kw_only=True)
 class _ForcePath(_SignalPath):
     force: str
 
@@ -164,38 +62,36 @@ class _MomentPath(_SignalPath):
     moment: str
 
 
-@attrs.frozen(kw_only=True)
-class ExternalForceDeviation(_ForcePath):
-    """F - F_exp of a ground reaction force column (N)."""
-
-    type: ClassVar[str] = "external_force_deviation"
-    family: ClassVar[str] = "external_force"
-    deviation: ClassVar[bool] = True
-
-
-@attrs.frozen(kw_only=True)
-class ExternalForceValue(_ForcePath):
-    """F of a ground reaction force column (N)."""
-
-    type: ClassVar[str] = "external_force_value"
-    family: ClassVar[str] = "external_force"
-
-
-@attrs.frozen(kw_only=True)
-class ExternalMomentDeviation(_MomentPath):
-    """M - M_exp of a ground reaction moment column (N·m)."""
-
-    type: ClassVar[str] = "external_moment_deviation"
-    family: ClassVar[str] = "external_moment"
-    deviation: ClassVar[bool] = True
+#: One row per signal family: (family, class-name stem, base with the family's fields,
+#: docstring of ``<family>_value``, docstring of ``<family>_deviation``).
+_SIGNAL_PATHS: tuple[tuple[str, str, type, str, str], ...] = (
+    ("generalized_coordinate", "GeneralizedCoordinate", _CoordinatePath, "q (rad or m).", "q - q_exp (rad or m)."),
+    ("generalized_speed", "GeneralizedSpeed", _CoordinatePath, "q̇ (rad/s or m/s).", "q̇ - q̇_exp (rad/s or m/s)."),
+    ("generalized_acceleration", "GeneralizedAcceleration", _CoordinatePath, "q̈ (rad/s² or m/s²).",
+     "q̈ - q̈_exp (rad/s² or m/s²)."),
+    ("marker_position", "MarkerPosition", _MarkerPath, "p on one axis (m).", "p - p_exp on one axis (m)."),
+    ("marker_velocity", "MarkerVelocity", _MarkerPath, "ṗ on one axis (m/s).", "ṗ - ṗ_exp on one axis (m/s)."),
+    ("body_orientation", "BodyOrientation", _BodyPath, "θ about one axis (rad).", "θ - θ_exp about one axis (rad)."),
+    ("external_force", "ExternalForce", _ForcePath, "F of a ground reaction force column (N).",
+     "F - F_exp of a ground reaction force column (N)."),
+    ("external_moment", "ExternalMoment", _MomentPath, "M of a ground reaction moment column (N·m).",
+     "M - M_exp of a ground reaction moment column (N·m)."),
+)
 
 
-@attrs.frozen(kw_only=True)
-class ExternalMomentValue(_MomentPath):
-    """M of a ground reaction moment column (N·m)."""
+def _signal_path_class(family: str, stem: str, base: type, doc: str, deviation: bool) -> type:
+    """The registered class ``<stem>Deviation`` (``<family>_deviation``) or ``<stem>Value``."""
+    suffix = "Deviation" if deviation else "Value"
+    namespace = {"__doc__": doc, "__module__": __name__, "__qualname__": stem + suffix,
+                 "type": f"{family}_{suffix.lower()}", "family": family, "deviation": deviation}
+    return attrs.frozen(kw_only=True)(type(stem + suffix, (base,), namespace))
 
-    type: ClassVar[str] = "external_moment_value"
-    family: ClassVar[str] = "external_moment"
+
+for _family, _stem, _base, _value_doc, _deviation_doc in _SIGNAL_PATHS:
+    for _deviation, _doc in ((True, _deviation_doc), (False, _value_doc)):
+        _cls = _signal_path_class(_family, _stem, _base, _doc, _deviation)
+        globals()[_cls.__name__] = _cls
+del _family, _stem, _base, _value_doc, _deviation_doc, _deviation, _doc, _cls
 
 
 @attrs.frozen(kw_only=True)

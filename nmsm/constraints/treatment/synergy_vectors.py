@@ -16,7 +16,7 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.tools.treatment.term_bases import TerminalConstraint
+from nmsm.core.ocp import TerminalConstraint
 
 SYNERGY_TOOLS = frozenset({"TO", "DO"})
 

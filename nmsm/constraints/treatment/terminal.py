@@ -26,8 +26,8 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.signals import SIGNALS
-from nmsm.tools.treatment.term_bases import TerminalConstraint
+from nmsm.core.signals import SIGNALS
+from nmsm.core.ocp import TerminalConstraint
 
 VARIANTS = ("periodicity", "initial_deviation", "initial_value", "final_deviation", "final_value")
 

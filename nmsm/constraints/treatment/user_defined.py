@@ -1,6 +1,6 @@
 """``user_defined`` constraint term (DO): a Python function's output, path or terminal.
 
-Elements: ``function_name`` (see :mod:`nmsm.tools.treatment.user_functions`),
+Elements: ``function_name`` (see :mod:`nmsm.terms.treatment.user_functions`),
 ``constraint_term_type`` (``path`` | ``terminal``), ``max_error``/``min_error``, and extra
 elements for the function (``term.options``).
 """
@@ -13,9 +13,9 @@ from typing import Any, ClassVar
 import attrs
 
 from nmsm.core.term import TermSpec
-from nmsm.tools.treatment.term_bases import PathConstraint
-from nmsm.tools.treatment.user_functions import resolve_user_function
-from nmsm.tools.treatment.user_terms import from_spec_with_options, options_field
+from nmsm.core.ocp import PathConstraint
+from nmsm.terms.treatment.user_functions import resolve_user_function
+from nmsm.core.user_terms import from_spec_with_options, options_field
 
 CONSTRAINT_KINDS = ("path", "terminal")
 
@@ -31,8 +31,9 @@ class UserDefinedConstraint(PathConstraint):
     options: Mapping[str, str] = options_field()
 
     @property
-    def terminal(self) -> bool:  # type: ignore[override]
-        return self.constraint_term_type == "terminal"
+    def evaluation(self) -> str:  # type: ignore[override]
+        """``terminal`` or ``path``, as ``<constraint_term_type>`` says."""
+        return "terminal" if self.constraint_term_type == "terminal" else "path"
 
     @classmethod
     def from_spec(cls, spec: TermSpec) -> list[Any]:

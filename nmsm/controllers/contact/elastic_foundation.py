@@ -26,6 +26,7 @@ class ElasticFoundationContact(ContactModel):
     """Spring-grid foot contact of an ``.osimx`` contact surface."""
 
     type: ClassVar[str] = "elastic_foundation"
+    moment_about_floor_point: ClassVar[bool] = True
 
     def __init__(self, surface: Any, model: Any, index: int) -> None:
         self.surface = ContactSurfaceModel.from_osimx(surface, model)
@@ -38,6 +39,10 @@ class ElasticFoundationContact(ContactModel):
         self.values: list[Any] = list(self.surface.parameters.vector())
         #: (1, n_m) values of the model's joint-frame parameters (DO model functions), or None
         self.model_parameter_row: Any = None
+
+    @property
+    def hindfoot_body(self) -> str | None:
+        return self.surface.hindfoot_body
 
     @classmethod
     def discover(cls, setup: Any) -> list[ContactModel]:

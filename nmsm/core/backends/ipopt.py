@@ -17,7 +17,7 @@ import numpy as np
 from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import interrupt_after_solve
-from nmsm.core.problem import Solution
+from nmsm.core.solution import Solution
 from nmsm.core.progress import SolveProgress, solve_progress
 
 if TYPE_CHECKING:

@@ -17,7 +17,7 @@ import scipy.sparse
 
 from nmsm.core.backends.sparse import SparseOutput
 from nmsm.core.convergence import ConvergenceHistory
-from nmsm.core.problem import Solution
+from nmsm.core.solution import Solution
 from nmsm.core.progress import with_least_squares_progress
 
 if TYPE_CHECKING:

@@ -10,12 +10,8 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from nmsm.io.settings.document import (
-    PIPELINE_VERSION_TEXT,
-    TOOL_ELEMENTS,
-    SettingsDocument,
-    read_settings_document,
-)
+from nmsm.io.settings.document import PIPELINE_VERSION_TEXT, TOOL_ELEMENTS, SettingsDocument
+from nmsm.io.settings.classes import SETTINGS_CLASSES
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings
@@ -26,18 +22,8 @@ from nmsm.io.settings.treatment import (
     TrackingOptimizationSettings,
     VerificationOptimizationSettings,
 )
+from nmsm.io.settings.reader import read_settings_document
 
-#: tool element -> settings class
-SETTINGS_CLASSES: dict[str, type] = {
-    "JointModelPersonalizationTool": JointModelPersonalizationSettings,
-    "MuscleTendonPersonalizationTool": MuscleTendonPersonalizationSettings,
-    "NeuralControlPersonalizationTool": NeuralControlPersonalizationSettings,
-    "GroundContactPersonalizationTool": GroundContactPersonalizationSettings,
-    "TrackingOptimizationTool": TrackingOptimizationSettings,
-    "VerificationOptimizationTool": VerificationOptimizationSettings,
-    "DesignOptimizationTool": DesignOptimizationSettings,
-    "OptimalControlSolverSettings": OptimalControlSolverSettings,
-}
 #: short code (``nmsm print-xml``) -> tool element
 TOOL_CODES: dict[str, str] = {code: element for element, code in TOOL_ELEMENTS.items()}
 

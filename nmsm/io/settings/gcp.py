@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.core.term import SourceRef, TermSpec
+from nmsm.io.term_spec import SourceRef, TermSpec
 from nmsm.errors import InputError
 from nmsm.io.settings.document import SettingsDocument
 from nmsm.io.settings.schema import ReadContext, at_least_one, non_negative, positive, read_block, setting

@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.core.term import SourceRef
+from nmsm.io.term_spec import SourceRef
 from nmsm.io.paths import normalize_separators
 from nmsm.io.settings.document import SettingsDocument
 from nmsm.io.settings.schema import ReadContext, increasing_pair, positive, read_block, setting

@@ -7,7 +7,7 @@ from typing import Any
 
 import attrs
 
-from nmsm.core.term import TermSpec
+from nmsm.io.term_spec import TermSpec
 from nmsm.io.settings.schema import ReadContext, not_empty, positive, setting
 
 _MTLI_TERM = ({"is_enabled": "true", "type": "passive_joint_moment", "max_allowable_error": "2"},)

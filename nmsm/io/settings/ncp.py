@@ -7,7 +7,7 @@ from typing import Any
 
 import attrs
 
-from nmsm.core.term import TermSpec
+from nmsm.io.term_spec import TermSpec
 from nmsm.io.settings.document import SettingsDocument
 from nmsm.io.settings.muscle_common import MuscleToolSettings
 from nmsm.io.settings.schema import ReadContext, at_least_one, positive, read_block, setting

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.core.term import SourceRef, TermSpec
+from nmsm.io.term_spec import SourceRef, TermSpec
 from nmsm.io.settings.document import SettingsDocument, elements
 from nmsm.io.settings.schema import (
     ReadContext,

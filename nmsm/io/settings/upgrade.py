@@ -13,7 +13,7 @@ Schemas recognized (:func:`detect_schema`):
 
 The upgrade moves the original elements (so errors still point at the old file's lines),
 renames what has a current equivalent and replaces what has none by an XML comment, with
-a note (a warning when read by :func:`~nmsm.io.settings.document.read_settings_document`).
+a note (a warning when read by :func:`~nmsm.io.settings.reader.read_settings_document`).
 """
 
 from __future__ import annotations
@@ -22,123 +22,15 @@ import copy
 import os
 from pathlib import Path
 
-import attrs
 from lxml import etree
 
 from nmsm.errors import InputError
+from nmsm.io.settings import upgrade_legacy_personalization, upgrade_legacy_treatment, upgrade_released
+from nmsm.io.settings.classes import SETTINGS_CLASSES
 from nmsm.io.settings.document import PIPELINE_VERSION_TEXT, ROOT, TOOL_ELEMENTS, elements, parse_version
+from nmsm.io.settings.upgrader import UpgradeResult, Upgrader, child_of
 
 SCHEMAS = ("current", "opensim-2023", "treatment-0.1", "gpops-0.1")
-
-
-@attrs.define
-class UpgradeResult:
-    """The upgraded root and what was changed or could not be carried over."""
-
-    root: etree._Element
-    schema: str
-    notes: list[str] = attrs.field(factory=list)
-
-
-class Upgrader:
-    """Editing helpers that keep source lines and record notes."""
-
-    def __init__(self, root: etree._Element, path: Path, schema: str) -> None:
-        self.root = root
-        self.path = path
-        self.schema = schema
-        self.notes: list[str] = []
-
-    # ----- notes ------------------------------------------------------------------------
-    def note(self, element: etree._Element | None, message: str) -> None:
-        where = f"line {element.sourceline}: " if element is not None and element.sourceline else ""
-        self.notes.append(where + message)
-
-    # ----- edits ------------------------------------------------------------------------
-    @staticmethod
-    def new(tag: str, text: str | None = None, *, like: etree._Element | None = None) -> etree._Element:
-        element = etree.Element(tag)
-        element.text = text
-        if like is not None and like.sourceline:
-            element.sourceline = like.sourceline
-        return element
-
-    def rename(self, element: etree._Element, tag: str) -> etree._Element:
-        element.tag = tag
-        return element
-
-    def rename_child(self, parent: etree._Element, old: str, new: str) -> etree._Element | None:
-        child = child_of(parent, old)
-        if child is not None:
-            if child_of(parent, new) is not None:
-                self.drop(child, f"both <{old}> and <{new}> are present; <{new}> kept")
-                return None
-            child.tag = new
-        return child
-
-    def drop(self, element: etree._Element, why: str) -> None:
-        """Replace ``element`` (and the descriptive comment just before it) by a comment quoting it; note why."""
-        parent = element.getparent()
-        self.remove_description(element)
-        copy_ = copy.deepcopy(element)
-        copy_.tail = None
-        for c in list(copy_.iter(etree.Comment)):
-            c.getparent().remove(c)
-        quoted = " ".join(etree.tostring(copy_, encoding="unicode").split()).replace("--", "- -")
-        comment = etree.Comment(f" nmsm upgrade-settings: {quoted} dropped: {why} ")
-        comment.tail = element.tail
-        parent.replace(element, comment)
-        self.note(element, f"<{element.tag}> dropped: {why}")
-
-    @staticmethod
-    def remove_description(element: etree._Element) -> None:
-        """Remove the comment right before ``element`` (the old file's description of it)."""
-        previous = element.getprevious()
-        if previous is not None and previous.tag is etree.Comment and not (previous.text or "").startswith(" nmsm"):
-            previous.getparent().remove(previous)
-
-    def ensure(
-        self, parent: etree._Element, tag: str, text: str = "", *, why: str | None = None, index: int | None = None
-    ) -> etree._Element:
-        found = child_of(parent, tag)
-        if found is not None:
-            return found
-        element = self.new(tag, text, like=parent)
-        if index is None:
-            parent.append(element)
-        else:
-            parent.insert(index, element)
-        if why:
-            self.note(parent, f"<{tag}>{text}</{tag}> added: {why}")
-        return element
-
-    def flatten_sets(self) -> None:
-        """Remove OpenSim ``<objects>`` wrappers and ``<groups>`` elements everywhere."""
-        for objects in list(self.root.iter("objects")):
-            parent = objects.getparent()
-            position = parent.index(objects)
-            for child in reversed(list(objects)):
-                parent.insert(position, child)
-            parent.remove(objects)
-        for groups in list(self.root.iter("groups")):
-            if len(list(elements(groups))):
-                self.drop(groups, "OpenSim set groups have no current equivalent")
-            else:
-                groups.getparent().remove(groups)
-
-    def set_root(self, tool: etree._Element) -> None:
-        """Make ``<NMSMPipelineDocument Version=current>`` the root holding ``tool``."""
-        root = etree.Element(ROOT, Version=PIPELINE_VERSION_TEXT)
-        root.sourceline = self.root.sourceline
-        root.append(tool)
-        self.root = root
-
-
-def child_of(parent: etree._Element, tag: str) -> etree._Element | None:
-    for child in elements(parent):
-        if child.tag == tag:
-            return child
-    return None
 
 
 def detect_schema(root: etree._Element) -> str:
@@ -157,8 +49,6 @@ def detect_schema(root: etree._Element) -> str:
 
 def upgrade_tree(root: etree._Element, path: str | os.PathLike[str]) -> UpgradeResult:
     """Upgrade a parsed settings root (a copy; ``root`` is untouched)."""
-    from nmsm.io.settings import upgrade_legacy_personalization, upgrade_legacy_treatment, upgrade_released
-
     path = Path(path)
     schema = detect_schema(root)
     work = copy.deepcopy(root)
@@ -188,7 +78,6 @@ def upgrade_tree(root: etree._Element, path: str | os.PathLike[str]) -> UpgradeR
 
 def _note_missing_required(up: Upgrader) -> None:
     """Note required elements that the old file did not have (they have no old equivalent)."""
-    from nmsm.io.settings import SETTINGS_CLASSES
     from nmsm.io.settings.schema import settings_fields
 
     tool = next(elements(up.root), None)
@@ -207,7 +96,6 @@ def _note_missing_required(up: Upgrader) -> None:
 
 def _output_elements(tool_tag: str) -> set[str]:
     """Element names the current settings class of ``tool_tag`` declares as outputs (results folders)."""
-    from nmsm.io.settings import SETTINGS_CLASSES
     from nmsm.io.settings.schema import settings_fields
 
     names = {"results_directory"}

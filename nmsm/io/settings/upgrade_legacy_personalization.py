@@ -11,7 +11,7 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import TOOL_ELEMENTS, elements
-from nmsm.io.settings.upgrade import Upgrader, child_of
+from nmsm.io.settings.upgrader import Upgrader, child_of
 from nmsm.io.xml_input import element_text, refuse_entities, set_element_text, xml_parser
 
 #: 2021 JMP option names -> current

@@ -15,7 +15,7 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import elements
-from nmsm.io.settings.upgrade import Upgrader, child_of
+from nmsm.io.settings.upgrader import Upgrader, child_of
 
 #: 0.1.0 ``<type_of_controller>`` values (the original accepts only these two controllers)
 CONTROLLER_TYPES = ("torque_driven", "synergy_driven")

@@ -23,7 +23,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.settings.document import elements
-from nmsm.io.settings.upgrade import Upgrader, child_of
+from nmsm.io.settings.upgrader import Upgrader, child_of
 from nmsm.io.settings.upgrade_legacy_personalization import _first_child, _last, _read_model
 
 #: (tool element, parent element, element) -> the releases that wrote it; the current original

@@ -18,7 +18,5 @@ class FootCostTerm(CostTerm):
         raise NotImplementedError(f"{type(self).__name__}.foot_quantity")
 
     def quantity(self, ctx: Any) -> tuple[Any, ...]:
+        """One raw block per foot (the base class normalizes each block)."""
         return tuple(self.foot_quantity(ctx, foot) for foot in range(ctx.n_feet))
-
-    def normalized(self, ctx: Any) -> tuple[Any, ...]:
-        return tuple((block - self.error_center) / self.max_allowable_error for block in self.quantity(ctx))

@@ -9,8 +9,5 @@ from nmsm.core.term import CostTerm
 
 @attrs.frozen(kw_only=True)
 class BlockCostTerm(CostTerm):
-    """``quantity`` returns a tuple of blocks; each is normalized and reduced on its own."""
-
-    def normalized(self, ctx):
-        blocks = self.quantity(ctx)
-        return tuple((b - self.error_center) / self.max_allowable_error for b in blocks)
+    """``quantity`` returns a tuple of blocks; each is normalized (by :meth:`CostTerm.normalized`)
+    and reduced on its own."""

@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.term_bases import ContinuousCost, require_axis
+from nmsm.core.ocp import ContinuousCost, require_axis
 
 
 @attrs.frozen(kw_only=True)

@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 import attrs
 import casadi as cs
 
-from nmsm.tools.treatment.term_bases import ContinuousCost
+from nmsm.core.ocp import ContinuousCost
 
 
 @attrs.frozen(kw_only=True)

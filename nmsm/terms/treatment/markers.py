@@ -13,8 +13,8 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.signals import SIGNALS
-from nmsm.tools.treatment.term_bases import ContinuousCost
+from nmsm.core.signals import SIGNALS
+from nmsm.core.ocp import ContinuousCost
 
 
 @attrs.frozen(kw_only=True)

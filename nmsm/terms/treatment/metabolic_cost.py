@@ -26,7 +26,7 @@ from typing import Any, ClassVar
 import attrs
 
 from nmsm.terms.treatment.walking_speed import mean_forward_speed
-from nmsm.tools.treatment.term_bases import DiscreteCost
+from nmsm.core.ocp import DiscreteCost
 
 
 def mean_metabolic_power(ctx: Any) -> Any:

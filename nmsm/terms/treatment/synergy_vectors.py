@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 import attrs
 import casadi as cs
 
-from nmsm.tools.treatment.term_bases import DiscreteCost
+from nmsm.core.ocp import DiscreteCost
 
 
 @attrs.frozen(kw_only=True)

@@ -1,7 +1,7 @@
 """``user_defined`` cost term (DO): a Python function's output as a continuous or discrete cost.
 
 Elements: ``function_name`` (``package.module:function`` or a registered name, see
-:mod:`nmsm.tools.treatment.user_functions`), ``cost_term_type`` (``continuous`` |
+:mod:`nmsm.terms.treatment.user_functions`), ``cost_term_type`` (``continuous`` |
 ``discrete``), ``max_allowable_error``/``error_center``, and any extra elements the function
 reads from ``term.options`` (e.g. ``marker_name``, ``target_speed``).
 """
@@ -14,9 +14,9 @@ from typing import Any, ClassVar
 import attrs
 
 from nmsm.core.term import TermSpec
-from nmsm.tools.treatment.term_bases import ContinuousCost
-from nmsm.tools.treatment.user_functions import resolve_user_function
-from nmsm.tools.treatment.user_terms import from_spec_with_options, options_field
+from nmsm.core.ocp import ContinuousCost
+from nmsm.terms.treatment.user_functions import resolve_user_function
+from nmsm.core.user_terms import from_spec_with_options, options_field
 
 COST_KINDS = ("continuous", "discrete")
 
@@ -32,8 +32,9 @@ class UserDefinedCost(ContinuousCost):
     options: Mapping[str, str] = options_field()
 
     @property
-    def discrete(self) -> bool:  # type: ignore[override]
-        return self.cost_term_type == "discrete"
+    def evaluation(self) -> str:  # type: ignore[override]
+        """``discrete`` or ``continuous``, as ``<cost_term_type>`` says."""
+        return "discrete" if self.cost_term_type == "discrete" else "continuous"
 
     @classmethod
     def from_spec(cls, spec: TermSpec) -> list[Any]:

@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from nmsm.tools.treatment.term_bases import DiscreteCost
+from nmsm.core.ocp import DiscreteCost
 
 
 def mean_forward_speed(ctx: Any) -> Any:

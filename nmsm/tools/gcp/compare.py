@@ -95,9 +95,9 @@ def score_original(settings_file: Path, results: Path) -> ScoredResult:
     and, when present, the adjusted GRF file ``GRFData/updated_<grf>`` or
     ``GRFData/gcp_adjusted<grf>`` giving electrical-center shifts) with the cost of the last
     task of ``settings_file``, all feet together."""
-    from nmsm.core.term import build_terms
+    from nmsm.core.registry import build_terms
     from nmsm.io.osimx import read_osimx
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.problem import build_task_problem
     from nmsm.tools.gcp.report import rms_errors

@@ -50,11 +50,11 @@ from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_c
 from nmsm.core.console import announce, summarize
 from nmsm.core.problem import Solution
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
-from nmsm.core.term import build_terms
+from nmsm.core.registry import build_terms
 from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, read_osimx
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.osim import load_model

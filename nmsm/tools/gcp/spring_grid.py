@@ -154,8 +154,3 @@ def layout_from_osimx(springs: Sequence[object], foot: FootModel, *, source: str
                          expected="at least one <GCPSpring>")
     return SpringLayout(tuple(bodies), np.array(locations).reshape(-1, 3), tuple(names))
 
-
-def default_spring_height(model_default_origin_height: float) -> float:
-    """The springs' y (m) in the hindfoot frame: minus the hindfoot origin height (m) in the
-    model's default pose."""
-    return -float(model_default_origin_height)

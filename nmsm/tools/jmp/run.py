@@ -45,7 +45,7 @@ from nmsm.core.convergence import CONVERGENCE_TABLE, format_convergence_table
 from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.results import ResultsDirectory
 from nmsm.core.unconverged import diagnosis_text, settle, status_hints
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
 from nmsm.io.storage import write_storage
 from nmsm.tools.jmp.ik import marker_error_table, write_motion

@@ -20,10 +20,10 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from nmsm.core.registry import get_registry
 from nmsm.io.settings.jmp import JmpTask
 from nmsm.io.trc import read_trc
 from nmsm.model.osim import load_model
-from nmsm.terms.jmp.marker_distance import MarkerDistanceError
 from nmsm.tools.jmp.design import TaskDesign, build_design
 from nmsm.tools.jmp.ik import IkResult, inverse_kinematics
 from nmsm.tools.jmp.levenberg_marquardt import Tolerances
@@ -176,7 +176,8 @@ def run_task(model_file: Path, task: JmpTask, position: int, *, allowable_error:
     before = attrs.evolve(before, unit_factor=factor)
     notes = _warn_small_motion(label, design, task, before, settings_file)
     q0 = before.q[:, [before.coordinate_names.index(n) for n in kinematics.free_names]]
-    term = MarkerDistanceError(max_allowable_error=allowable_error, name=task.name, source=task.source)
+    term = get_registry().get("cost", "marker_distance_error", "JMP")(
+        max_allowable_error=allowable_error, name=task.name, source=task.source)
     problem = JmpProblem(kinematics, trial, [term], design.lower, design.upper)
     solution = solve_reseating_frames(problem, model, trial, kinematics, design, q0, p0, tolerances, ik_accuracy)
     log(f"{label}: {solution.status} after {solution.iterations} iterations ({solution.wall_time:.1f} s); "

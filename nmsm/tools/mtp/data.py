@@ -176,11 +176,6 @@ def read_moment_arms(
     return np.stack(arms, axis=1)
 
 
-def read_inverse_dynamics(path: Path, coordinates: Sequence[str]) -> Table:
-    """The ID table of a trial (labels ``<coord>_moment``/``_force`` or bare)."""
-    return read_storage(path)
-
-
 def emg_padding(n_emg: int, n_frames: int, source: Path | None = None) -> int:
     """Padding frames per side: ``(n_emg - n_frames) / 2``; error unless a non-negative integer."""
     extra = n_emg - n_frames

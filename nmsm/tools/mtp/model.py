@@ -25,7 +25,6 @@ Shapes of :class:`TrialModel` fields: excitations ``(n_emg, n_muscles)``, the re
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
 import attrs
@@ -273,13 +272,3 @@ def expand_emg(emg: np.ndarray, channel_of_muscle: np.ndarray) -> np.ndarray:
     out[:, has] = emg[:, channel_of_muscle[has]]
     return out
 
-
-def trial_models(
-    chains: Sequence[TrialChain],
-    muscles: MuscleParameters,
-    design: MuscleDesign,
-    excitation_samples: Sequence[Any],
-    vmax_factor: float,
-) -> list[TrialModel]:
-    """Modeled quantities of every trial (nothing lifted)."""
-    return [c.evaluate(muscles, design, x, vmax_factor) for c, x in zip(chains, excitation_samples)]

@@ -66,15 +66,11 @@ CONSTRAINT_MAX_LENGTH = 1.3
 CONSTRAINT_MIN_LENGTH = 0.3
 
 #: IPOPT's initial barrier parameter of :func:`solve_task_problem` (IPOPT's default 0.1, which
-#: MTLI keeps), chosen by measurement (2026-11-25, docs/mtp.md):
-#: Patient 3 144 -> 118 iterations, cost 65.2784 -> 65.2657; tutorial V1 36 -> 40, V2 30 -> 26,
-#: V3 15 -> 14, V1 with NMF 26 -> 36, 40 synthetic known-answer cases 584 -> 558 in all (these
-#: with the same costs to 1e-4, each synthetic case recovering the truth).
+#: MTLI keeps); the measurements that chose it are in docs/mtp.md.
 TASK_MU_INIT = 1e-3
 #: MUMPS fill-reducing ordering of :func:`solve_task_problem` (IPOPT's ``mumps_pivot_order``:
-#: 2 = approximate minimum fill). Same iterates as MUMPS's automatic choice; Patient 3's 118
-#: iterations in 134.6 s of IPOPT time instead of 144.5 s (2026-11-26, docs/mtp.md); the
-#: tutorial V1 unchanged (2.1 s).
+#: 2 = approximate minimum fill): the same iterates as MUMPS's automatic choice, faster on the
+#: larger problems (docs/mtp.md).
 TASK_MUMPS_ORDERING = 2
 #: threads of the block-wise Jacobian and Hessian evaluations of :func:`solve_task_problem`
 #: (:func:`nmsm.tools.mtp.derivatives.parallel_sum`; :data:`nmsm.core.threads.SOLVER_THREADS`).

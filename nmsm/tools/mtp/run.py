@@ -42,12 +42,13 @@ import numpy as np
 from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
-from nmsm.core.term import CostTerm, build_terms
+from nmsm.core.registry import build_terms
+from nmsm.core.term import CostTerm
 from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.errors import InputError, SolverError
 from nmsm.io.layout import trial_table_folders
 from nmsm.io.osimx import OsimxModel, read_osimx
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
 from nmsm.tools.mtp import outputs
 from nmsm.tools.mtp.data import check_same_frame_counts, find_prefixes, load_trial

@@ -22,7 +22,8 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from nmsm.core.term import Term, build_terms
+from nmsm.core.term import Term
+from nmsm.core.registry import build_terms
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, check_muscles_in_model, read_osimx
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings

@@ -9,7 +9,7 @@ Design variables (all >= 0, no upper bounds; tools.md §5):
 Activations ``a_t = (B @ nodes_t) @ W`` are bilinear in the variables and moments linear in
 activations, so the objective is a quartic polynomial; its exact Hessian is assembled from
 that structure (:meth:`NcpProblem.ipopt_options`, :mod:`nmsm.tools.ncp.hessian`).
-Each free group's vectors sum to ``M_g/100`` (:class:`SynergyWeightSum`).
+Each free group's vectors sum to ``M_g/100`` (the registered constraint ``synergy_weight_sum``).
 
 Proximal term: with the settings' terms alone the activations can be undetermined (e.g.
 moment tracking only: infinitely many synergy sets give the same moments) and an
@@ -31,8 +31,8 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.constraints.ncp.synergy_weight_sum import SynergyWeightSum
 from nmsm.core.problem import OptimizationProblem, Solution
+from nmsm.core.registry import get_registry
 from nmsm.core.term import CostTerm, Term
 from nmsm.tools.ncp.context import NcpContext
 from nmsm.tools.ncp.initial_guess import SynergyGuess
@@ -154,9 +154,10 @@ def build_problem(
 
         problem.add_cost(PROXIMAL_ENTRY, proximal(context), weight=proximal_weight)
         builders.append((proximal_weight, proximal))
+    weight_sum = get_registry().get("constraint", "synergy_weight_sum", "NCP")
     for group in layout.free_groups:
         g = layout.groups[group]
-        problem.add_term(SynergyWeightSum(group=group, target=g.weight_sum, name=g.name), context)
+        problem.add_term(weight_sum(group=group, target=g.weight_sum, name=g.name), context)
     return NcpProblem(inputs, problem, context, weight_names, node_names, builders)
 
 

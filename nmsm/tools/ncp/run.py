@@ -32,7 +32,7 @@ from nmsm.core.results import ResultsDirectory
 from nmsm.core.unconverged import LAST_ITERATE, diagnosis_text, settle, status_hints
 from nmsm.errors import InputError
 from nmsm.io.layout import trial_table_folders
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.ncp import NeuralControlPersonalizationSettings
 from nmsm.tools.ncp.initial_guess import initial_guess
 from nmsm.tools.ncp.loading import NcpSetup, load_ncp

@@ -2,7 +2,7 @@
 ``<DataPreprocessingTool>``, ``<SurrogateDataTool>``) and of pipeline files.
 
 These tool elements are not tools of the original NMSM Pipeline, so they are read here
-rather than by :func:`~nmsm.io.settings.document.read_settings_document`; the same root
+rather than by :func:`~nmsm.io.settings.reader.read_settings_document`; the same root
 (``<NMSMPipelineDocument Version="1.x">``), version check and declarative settings classes
 (:mod:`nmsm.io.settings.schema`) apply. ``nmsm run`` dispatches them through
 :data:`NATIVE_RUNNERS`.

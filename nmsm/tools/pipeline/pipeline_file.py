@@ -232,7 +232,7 @@ def _settings_tool_tag(settings_file: Path) -> str:
 
     root = parse_settings_xml(settings_file)
     if detect_schema(root) != "current":
-        from nmsm.io.settings.document import read_settings_document
+        from nmsm.io.settings.reader import read_settings_document
 
         return read_settings_document(settings_file, check_paths=False).tool
     tools = list(elements(root))

@@ -79,8 +79,9 @@ class StageSettings:
     @classmethod
     def from_file(cls, path: Path, settings_class: type, *, upgrade: bool = True) -> StageSettings:
         """Read a settings file; older schemas of the personalization and treatment tools are
-        upgraded in memory (:func:`~nmsm.io.settings.document.read_settings_document`)."""
-        from nmsm.io.settings.document import parse_settings_xml, read_settings_document
+        upgraded in memory (:func:`~nmsm.io.settings.reader.read_settings_document`)."""
+        from nmsm.io.settings.document import parse_settings_xml
+        from nmsm.io.settings.reader import read_settings_document
 
         if upgrade:
             root = read_settings_document(path, check_paths=False).root

@@ -78,7 +78,7 @@ def bind_stage(stage: StageSpec, settings: StageSettings) -> None:
 
 # ---- the built-in kinds' checks ----------------------------------------------------------------
 def _terms(specs: Any, tool: str) -> None:
-    from nmsm.core.term import build_terms
+    from nmsm.core.registry import build_terms
 
     build_terms(list(specs or ()), tool)
 
@@ -112,7 +112,7 @@ def gcp(settings: Any) -> None:
 
 def treatment(settings: Any) -> None:
     """TO, VO, DO: cost and constraint terms, the solver settings file, DO's model functions."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.solver import OptimalControlSolverSettings
 
     _terms(settings.cost_terms, settings.tool_code)
@@ -132,7 +132,7 @@ def treatment(settings: Any) -> None:
 def bind_treatment(settings: Any) -> None:
     """TO, VO, DO: the tool's own preparation (model, data, controllers; every term bound
     while the problem is assembled), not solved."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.solver import OptimalControlSolverSettings
     from nmsm.tools.treatment.tool import TreatmentOptions, prepare
 

@@ -7,7 +7,7 @@
 ``velocity``   muscle-tendon velocity from muscle-tendon length (``createMuscleTendonVelocity``)
 ``analyses``   IK / ID / MuscleAnalysis through nmsm's model core or OpenSim (bridge)
 ``run``        one recording -> trials
-``command``    the one checked path (``nmsm preprocess``, ``run.preprocess``, the pipeline's stage):
+``command``    the one checked path (``nmsm preprocess``, ``command.preprocess``, the pipeline's stage):
                arguments, output folder and inputs checked first, then ``run.process`` into a
                staging folder (``output``: no input's folder, no mixing of runs)
 ``cli``        ``nmsm preprocess``

@@ -1,6 +1,6 @@
 """The one checked path of preprocessing: everything checked first, then :func:`.run.process`
 into a staging folder, moved into place only when the whole run succeeded. ``nmsm
-preprocess``, :func:`.run.preprocess` and the pipeline's ``<DataPreprocessingTool>`` stage
+preprocess``, :func:`preprocess` (Python callers) and the pipeline's ``<DataPreprocessingTool>`` stage
 (several recordings into one folder) all run :func:`run_checked`.
 
 Before anything is processed (:func:`check_request`):
@@ -206,3 +206,9 @@ def run_checked(requests: PreprocessRequest | Sequence[PreprocessRequest], *,
 
 
 __all__ = ["check_input_times", "check_request", "planned_files", "run_checked", "trial_names"]
+
+
+def preprocess(request: PreprocessRequest) -> list[str]:
+    """Check ``request``, then run the steps of :mod:`nmsm.tools.preprocess.run` staged (nothing
+    is written on bad input, nothing half-written is left on an error); returns the trial names."""
+    return run_checked([request])

@@ -12,11 +12,11 @@ Steps (tools.md §2), each optional:
 Intermediate files go to ``<output>/intermediate/``; trials to ``<output>/{IKData, IDData,
 EMGData, GRFData, MAData}``.
 
-:func:`preprocess` is the checked path every entry point takes (``nmsm preprocess``, the
-pipeline's ``<DataPreprocessingTool>`` stage and Python callers): the request is checked
-first, then processed into a staging folder that is moved into place only when everything
-succeeded (:func:`nmsm.tools.preprocess.command.run_checked`). :func:`process` is the
-unchecked processing step alone, writing straight into ``request.output``.
+:func:`nmsm.tools.preprocess.command.preprocess` is the checked path every entry point takes
+(``nmsm preprocess``, the pipeline's ``<DataPreprocessingTool>`` stage and Python callers):
+the request is checked first, then processed into a staging folder that is moved into place
+only when everything succeeded (:func:`nmsm.tools.preprocess.command.run_checked`).
+:func:`process` is the unchecked processing step alone, writing straight into ``request.output``.
 """
 
 from __future__ import annotations
@@ -147,14 +147,6 @@ def _with_velocity(folder: Path, work: Path) -> Path:
                 shutil.copyfile(path, work / path.name)
     create_velocity_file(work / lengths[0].name)
     return work
-
-
-def preprocess(request: PreprocessRequest) -> list[str]:
-    """Check ``request``, then run the steps of the module docstring staged (nothing is
-    written on bad input, nothing half-written is left on an error); returns the trial names."""
-    from nmsm.tools.preprocess.command import run_checked
-
-    return run_checked([request])
 
 
 def process(request: PreprocessRequest, work: Path | None = None) -> list[str]:

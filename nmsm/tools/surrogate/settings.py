@@ -92,6 +92,6 @@ def surrogate_settings_from_document(doc: SettingsDocument) -> SurrogateSettings
 
 def read_surrogate_settings(path: str | os.PathLike[str]) -> SurrogateSettings:
     """Read the surrogate settings from a TO/VO/DO settings file."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
 
     return surrogate_settings_from_document(read_settings_document(path))

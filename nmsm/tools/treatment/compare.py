@@ -22,6 +22,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.ocp import evaluation_of
 from nmsm.tools.treatment.run import TreatmentRun, run_settings
 
 
@@ -72,7 +73,7 @@ def tracking_rms(run: TreatmentRun) -> dict[str, float]:
     ctx = run.prepared.built.context
     out = {}
     for term in run.prepared.terms:
-        if term.type.endswith("_tracking") and not getattr(term, "discrete", False):
+        if term.type.endswith("_tracking") and evaluation_of(term) != "discrete":
             values = run.result.value(term.quantity(ctx))
             out[term.label] = float(np.sqrt(np.mean(values**2)))
     return out

@@ -60,6 +60,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core import reductions
+from nmsm.core.ocp import evaluation_of
 from nmsm.tools.treatment.orientation import check_sequence
 from nmsm.tools.treatment.transcription.base import map_rows
 
@@ -242,13 +243,7 @@ class GridView:
     def foot_contacts(self, hindfoot_body: str) -> list[Any]:
         """Contact models whose loads act on ``hindfoot_body`` first (an elastic-foundation
         surface of that hindfoot, or the smooth spheres on that body)."""
-        out = []
-        for c in self._q.data.contact_models:
-            surface = getattr(c, "surface", None)
-            first = getattr(surface, "hindfoot_body", None) or (c.load_bodies[0] if c.load_bodies else None)
-            if first == hindfoot_body:
-                out.append(c)
-        return out
+        return [c for c in self._q.data.contact_models if c.hindfoot_body == hindfoot_body]
 
     def foot_ground_reaction(self, hindfoot_body: str) -> tuple[cs.MX, cs.MX, cs.MX]:
         """Summed over :meth:`foot_contacts`: force (n, 3) N, moment about the ground origin
@@ -257,12 +252,11 @@ class GridView:
         reference point projected on the floor (n, 3) m (y = 0), all in ground."""
         def compute(view: GridView) -> tuple[cs.MX, cs.MX, cs.MX]:
             force = moment = point = None
-            from nmsm.controllers.contact.elastic_foundation import ElasticFoundationContact
             from nmsm.tools.treatment.whole_body import foot_reaction_function
 
             for contact in self.foot_contacts(hindfoot_body):
-                g = foot_reaction_function(self._q._contact_function(contact), contact.name,
-                                           moment_about_floor_point=isinstance(contact, ElasticFoundationContact))
+                g = foot_reaction_function(self._q.contact_function(contact), contact.name,
+                                           moment_about_floor_point=contact.moment_about_floor_point)
                 F, M, P = view.map_kinematics_function(("foot_reaction", id(contact)), g, "q, qd", None,
                                                        (contact.parameters(),))
                 force = F if force is None else force + F
@@ -393,7 +387,11 @@ class GridView:
 
 
 class TreatmentContext(GridView):
-    """What terms receive: the collocation-point view, terminal views and problem-wide data."""
+    """What terms receive: the collocation-point view, terminal views and problem-wide data.
+
+    Implements :class:`nmsm.core.ocp.OcpContext`, the public protocol a term is written
+    against (every quantity with its units and shapes).
+    """
 
     def __init__(self, quantities: ContextQuantities) -> None:
         super().__init__(quantities, quantities.trajectory.integration_grid)
@@ -475,7 +473,7 @@ class TreatmentContext(GridView):
         return mask
 
     def reduce_cost(self, term: CostTerm, normalized: Any) -> Any:
-        if getattr(term, "discrete", False):
+        if evaluation_of(term) == "discrete":
             z = cs.MX(normalized)
             if z.numel() != 1:
                 raise term.error(f"a discrete cost must be a scalar, got shape {z.shape}")
@@ -491,7 +489,7 @@ class TreatmentContext(GridView):
 
     def reduce_constraint(self, term: ConstraintTerm, value: Any) -> tuple[Any, Any, Any]:
         v = cs.MX(value)
-        if getattr(term, "terminal", False):
+        if evaluation_of(term) == "terminal":
             if v.numel() != 1:
                 raise term.error(f"a terminal constraint must be a scalar, got shape {v.shape}")
         else:

@@ -23,6 +23,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core.problem import OptimizationProblem
+from nmsm.core.ocp import evaluation_of
 from nmsm.core.term import CostTerm, Term
 from nmsm.tools.treatment.context import TreatmentContext
 from nmsm.tools.treatment.problem_data import TreatmentData
@@ -86,7 +87,7 @@ def term_weights(terms: Sequence[Term], by_type: bool) -> dict[int, float]:
     costs = [t for t in terms if isinstance(t, CostTerm)]
     weights: dict[int, float] = {}
     for discrete in (False, True):
-        group = [t for t in costs if bool(getattr(t, "discrete", False)) == discrete]
+        group = [t for t in costs if (evaluation_of(t) == "discrete") == discrete]
         if not group:
             continue
         if by_type:

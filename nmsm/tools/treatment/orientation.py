@@ -42,14 +42,6 @@ def euler_angles(R: Any, sequence: str = "xyz") -> list[Any]:
     return [a, b, c]
 
 
-def angle_about(R: Any, axis: str, sequence: str = "xyz") -> Any:
-    """The angle of ``sequence`` about ``axis`` ('x', 'y' or 'z')."""
-    seq = check_sequence(sequence)
-    if axis not in _AXIS:
-        raise ValueError(f"axis must be x, y or z, got '{axis}'")
-    return euler_angles(R, seq)[seq.index(axis)]
-
-
 def rotation(axis: str, angle: float) -> np.ndarray:
     """Elementary rotation matrix about ``axis`` (numpy)."""
     c, s = np.cos(angle), np.sin(angle)

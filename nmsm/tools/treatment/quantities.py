@@ -233,7 +233,8 @@ class ContextQuantities:
             return tau
         return self.cache((grid, "inverse_dynamics"), compute)
 
-    def _contact_function(self, contact: Any) -> cs.Function:
+    def contact_function(self, contact: Any) -> cs.Function:
+        """The contact model's point function on this problem's model (cached)."""
         return self.cache(("contact_function", id(contact)), lambda: contact.point_function(self.data.model))
 
     def _contact_inverse_dynamics_function(self) -> cs.Function:
@@ -246,7 +247,7 @@ class ContextQuantities:
             q, qd, qdd = (cs.SX.sym(n, nq) for n in ("q", "qd", "qdd"))
             params, loads = [], []
             for c in contacts:
-                f = self._contact_function(c)
+                f = self.contact_function(c)
                 p = cs.SX.sym("p", f.size1_in(2))
                 params.append(p)
                 loads.append(f(q, qd, p)[0])
@@ -258,7 +259,7 @@ class ContextQuantities:
     def ground_reaction(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
         """(force, moment about the point, point), each (n, 3), ground, of one contact model."""
         def compute() -> tuple[cs.MX, cs.MX, cs.MX]:
-            f = self._contact_function(contact)
+            f = self.contact_function(contact)
             nq = len(self.data.model.coordinate_names)
             q, qd = cs.SX.sym("q", nq), cs.SX.sym("qd", nq)
             p = cs.SX.sym("p", f.size1_in(2))
@@ -288,7 +289,7 @@ class ContextQuantities:
             torque = refs.values(t, 0, contact.moment_labels)
             centre = refs.values(t, 0, contact.point_labels)
             q, qd, _ = self.data.tracked_full_kinematics(t)
-            f = self._contact_function(contact)
+            f = self.contact_function(contact)
             # the reference point's x and z do not depend on the contact parameters; a
             # parametric model's parameters (last entries of p) take the file's values
             n_model = self._parameter_count()

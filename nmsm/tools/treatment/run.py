@@ -63,7 +63,7 @@ class TreatmentRun:
 
 def load_settings(path: str | os.PathLike[str]) -> tuple[Any, Any]:
     """(tool settings, solver settings) of a TO/VO/DO settings file."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.solver import OptimalControlSolverSettings
     from nmsm.io.settings.treatment import (
         DesignOptimizationSettings,

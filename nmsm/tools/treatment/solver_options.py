@@ -31,13 +31,10 @@ from nmsm.tools.treatment.transcription.mesh import Mesh
 MAX_TOLERANCE = 1e-2
 
 #: loosest IPOPT ``tol`` of Design Optimization. A design goal (e.g. the final toe speed)
-#: makes the objective at the guess 800-30 000 times its optimum, so 1e-2 of the normalized
-#: objective stopped IPOPT early: torque DO V4 at 0.001763 instead of 0.001627, synergy DO V2
-#: (original time convention) at 6.205e-05 instead of 4.992e-05, the values IPOPT reaches
-#: from the original's solution. At 1e-6 the 11 kicking-tutorial DO runs end at those values
-#: (within 0.5 %), none higher than before, in 223 iterations and 61.6 s instead of 171 and
-#: 52.1 s (measured 2026-11-26, docs/treatment.md). TO and VO keep :data:`MAX_TOLERANCE`: there
-#: 1e-6 gains 0.3-0.7 % and costs up to 4 times the iterations.
+#: makes the objective at the guess orders of magnitude above its optimum, so
+#: :data:`MAX_TOLERANCE` of the normalized objective stops IPOPT before the optimum; TO and VO
+#: keep :data:`MAX_TOLERANCE`, where a tighter one gains little and costs iterations (the
+#: measurements: docs/treatment.md).
 DESIGN_MAX_TOLERANCE = 1e-6
 
 

@@ -17,11 +17,12 @@ import attrs
 import numpy as np
 
 from nmsm.core.registry import get_registry
-from nmsm.core.term import Term, build_terms
+from nmsm.core.term import Term
+from nmsm.core.registry import build_terms
 from nmsm.core.threads import SOLVER_THREADS
 from nmsm.errors import InputError
-from nmsm.tools.treatment.bounds import RangeRule, check_guess_within, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.bounds import RangeRule, check_guess_within, range_bounds
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
 from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files
 from nmsm.tools.treatment.model_interface import TreatmentModel
@@ -36,8 +37,8 @@ CONTROLLER_ELEMENTS = (("RCNLSynergyController", "synergy_controller"), ("RCNLMu
 
 
 #: threads of the per-point model functions (CasADi ``map`` with ``thread``
-#: parallelization; :data:`nmsm.core.threads.SOLVER_THREADS`). Same iterates as one thread;
-#: measured 2026-11-26: synergy TO V4 29.2 -> 20.4 s, torque TO V2 9.5 -> 7.0 s (docs/treatment.md).
+#: parallelization; :data:`nmsm.core.threads.SOLVER_THREADS`): the same iterates as one thread
+#: (timings: docs/treatment.md).
 DEFAULT_PARALLEL = SOLVER_THREADS
 
 

@@ -8,7 +8,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.io.osimx import GcpSpring, OsimxContactSurface
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.model.casadi_model import CasadiModel
 from nmsm.model.foot_contact import ContactSurfaceModel

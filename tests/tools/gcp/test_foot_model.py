@@ -34,7 +34,7 @@ def test_left_foot_uses_mirrored_axes():
 def test_synthetic_foot_reproduces_its_coordinates(synthetic_case):
     """The synthetic model's joint to ground has the foot's axes: experimental foot
     coordinates equal the motion's coordinate values, and velocities are exact rates."""
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.io.storage import read_storage
     from nmsm.tools.gcp.run import load_feet

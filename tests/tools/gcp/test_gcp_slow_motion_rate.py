@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from nmsm.errors import InputError
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.io.storage import read_storage, table_from_columns, write_storage
 from nmsm.tools.gcp import bspline

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from nmsm.io.osimx import read_osimx
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.io.storage import read_storage
 from nmsm.tools.gcp.compare import coefficients_from_kinematics, result_state, shifts_from_adjusted_grf

@@ -6,8 +6,8 @@ from __future__ import annotations
 import casadi as cs
 import numpy as np
 
-from nmsm.core.term import build_terms
-from nmsm.io.settings.document import read_settings_document
+from nmsm.core.registry import build_terms
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.tools.gcp.problem import build_task_problem
 from nmsm.tools.gcp.run import load_feet

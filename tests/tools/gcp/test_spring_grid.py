@@ -23,7 +23,7 @@ def test_outline_and_grid():
 
 
 def test_placement_on_synthetic_foot(synthetic_case):
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.run import load_feet
 
@@ -43,7 +43,7 @@ def test_placement_on_synthetic_foot(synthetic_case):
 
 
 def test_osimx_springs_must_be_on_the_foot(synthetic_case):
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.run import load_feet
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from nmsm.core.registry import get_registry
-from nmsm.core.term import SourceRef, TermSpec, build_terms
+from nmsm.core.term import SourceRef, TermSpec
+from nmsm.core.registry import build_terms
 
 GCP_TERMS = ("marker_position", "marker_slope", "rotation", "translation", "kinematic_periodicity", "vertical_grf",
              "vertical_grf_slope", "horizontal_grf", "horizontal_grf_slope", "ground_reaction_moment",
@@ -37,7 +38,7 @@ def test_axes_of_electrical_center_regularization():
 
 @pytest.fixture(scope="module")
 def synthetic_feet(synthetic_case):
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
     from nmsm.tools.gcp.run import load_feet
 

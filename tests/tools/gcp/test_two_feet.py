@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from nmsm.io.osimx import read_osimx
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.io.storage import read_storage
 from nmsm.tools.gcp.run import load_feet, run_settings

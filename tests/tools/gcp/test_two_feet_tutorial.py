@@ -21,7 +21,7 @@ from nmsm.cli import main
 from nmsm.errors import InputError
 from nmsm.examples.tutorial_two_feet import write_two_feet_tutorial
 from nmsm.io.osimx import read_osimx
-from nmsm.io.settings.document import read_settings_document
+from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.tools.gcp.run import load_feet, run_settings
 

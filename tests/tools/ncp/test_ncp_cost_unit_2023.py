@@ -14,7 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from nmsm.core.term import TermSpec, build_terms
+from nmsm.core.term import TermSpec
+from nmsm.core.registry import build_terms
 from nmsm.io.storage import read_storage
 from nmsm.model import hill
 from nmsm.tools.mtp.muscles import MuscleGroup, MuscleParameters

@@ -9,7 +9,8 @@ import casadi as cs
 import numpy as np
 import pytest
 
-from nmsm.core.term import CostTerm, TermSpec, build_terms
+from nmsm.core.term import CostTerm, TermSpec
+from nmsm.core.registry import build_terms
 from nmsm.examples.synthetic_ncp import make_synthetic_ncp_case
 from nmsm.tools.ncp.initial_guess import initial_guess
 from nmsm.tools.ncp.loading import load_ncp

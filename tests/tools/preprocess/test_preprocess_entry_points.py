@@ -1,5 +1,5 @@
 """Every way of starting preprocessing takes ``nmsm preprocess``'s checked path: the Python
-function :func:`nmsm.tools.preprocess.run.preprocess`, the ``<DataPreprocessingTool>``
+function :func:`nmsm.tools.preprocess.command.preprocess`, the ``<DataPreprocessingTool>``
 settings file (``nmsm run``) and the pipeline's preprocessing stage give the same checked
 error for the same bad input and leave no file behind."""
 
@@ -14,7 +14,8 @@ import pytest
 from nmsm.cli import main
 from nmsm.errors import InputError
 from nmsm.io.storage import table_from_columns, write_storage
-from nmsm.tools.preprocess.run import EmgOptions, PreprocessRequest, preprocess
+from nmsm.tools.preprocess.command import preprocess
+from nmsm.tools.preprocess.run import EmgOptions, PreprocessRequest
 from nmsm.tools.preprocess.velocity import create_velocity_file
 
 SHORT_ID = "ID covers 0-1.7 s but the trial needs 1.8-2.6 s"
@@ -78,7 +79,7 @@ def _stage_settings(folder: Path, results: str = "out") -> Path:
 
 
 def test_python_function_checks_first_and_stages(analysis: Path, tmp_path: Path) -> None:
-    """``run.preprocess``: the trial's disagreeing files and an output folder among the inputs
+    """``command.preprocess``: the trial's disagreeing files and an output folder among the inputs
     are refused before anything is written; good input is written as before."""
     id_file = _shorten_id(analysis)
     out = tmp_path / "out"

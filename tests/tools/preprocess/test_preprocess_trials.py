@@ -146,7 +146,8 @@ def test_ground_reaction_gaps_and_units(recording, tmp_path):
 
 
 def test_bad_preprocess_input(recording, tmp_path):
-    from nmsm.tools.preprocess.run import PreprocessRequest, parse_time_pairs, preprocess
+    from nmsm.tools.preprocess.command import preprocess
+    from nmsm.tools.preprocess.run import PreprocessRequest, parse_time_pairs
 
     tmp, sources, _ = recording
     with pytest.raises(InputError, match="EMG column.*Gastroc.*not in the EMG file"):
@@ -236,7 +237,8 @@ def test_settings_file_route(tmp_path):
 
 
 def test_velocity_made_without_touching_the_inputs(recording):
-    from nmsm.tools.preprocess.run import PreprocessRequest, preprocess
+    from nmsm.tools.preprocess.command import preprocess
+    from nmsm.tools.preprocess.run import PreprocessRequest
 
     tmp, sources, _ = recording
     ma = tmp / "src" / "MA_no_velocity"

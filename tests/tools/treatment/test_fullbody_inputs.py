@@ -47,7 +47,7 @@ def test_model_has_86_muscles_on_the_gcp_skeleton(shared_data, model_file):
 @pytest.mark.parametrize("side", ["r", "l"])
 def test_gcp_settings_of_each_foot_read(shared_data, model_file, tmp_path, side):
     from nmsm.examples.fullbody_gcp import gcp_settings_xml
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 
     shared = fd.shared_inputs(shared_data)

@@ -21,8 +21,8 @@ from nmsm.model.parameters import ModelParameters
 from nmsm.modifiers.joint_frame import ApplyJointFrameOrientationParameter
 from nmsm.terms.treatment.inverse_dynamics import InverseDynamicsLoadTracking
 from nmsm.terms.treatment.kinematics import GeneralizedCoordinateTracking
-from nmsm.tools.treatment.bounds import RangeRule, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.bounds import RangeRule, range_bounds
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 from nmsm.tools.treatment.modifiers import ModificationTarget

@@ -58,3 +58,11 @@ def test_documented_term_declares_its_settings_elements(tmp_path: Path) -> None:
     assert cls.type == "coordinate_limit_penalty"
     assert cls.tools == frozenset({"TO", "DO"})
     assert {"coordinate", "upper_limit", "sharpness"} <= set(cls.xml_fields())
+
+
+def test_documented_term_passes_check_term_as_documented(tmp_path: Path) -> None:
+    from nmsm.testing import check_term
+
+    cls = _documented_term_class(tmp_path)
+    report = check_term(cls, {"coordinate": "q0", "upper_limit": "0.2"})
+    assert report.not_built is None and "derivatives" in report.passed

@@ -56,7 +56,7 @@ def test_missing_surrogate_folder_prints_the_command_that_makes_it(shared_data, 
 
 
 def test_existing_surrogate_folder_passes_the_check(shared_data, tmp_path):
-    from nmsm.io.settings.document import read_settings_document
+    from nmsm.io.settings.reader import read_settings_document
     from nmsm.tools.treatment.surrogate_folder import check_surrogate_data_folder
 
     settings = _settings_with_missing_folder(shared_data, tmp_path)

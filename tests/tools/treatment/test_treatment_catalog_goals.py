@@ -21,8 +21,8 @@ from nmsm.terms.treatment.impulse import BrakingImpulseGoal, PropulsiveImpulseGo
 from nmsm.terms.treatment.walking_speed import RelativeWalkingSpeedGoal
 from nmsm.constraints.treatment.center_of_pressure import CenterOfPressureDeviation, CenterOfPressureValue
 from nmsm.errors import InputError
-from nmsm.tools.treatment.bounds import RangeRule, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.bounds import RangeRule, range_bounds
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.metabolics import metabolic_point_function
 from nmsm.tools.treatment.problem_data import TreatmentData

@@ -22,8 +22,8 @@ from nmsm.errors import InputError
 from nmsm.examples.pendulum import Pendulum
 from nmsm.terms.treatment import (angular_momentum, center_of_pressure, controllers, ground_reactions, impulse,
                                   inverse_dynamics, kinematics, markers)
-from nmsm.tools.treatment.bounds import RangeRule, range_bounds
-from nmsm.tools.treatment.controller_setup import ControllerSetup
+from nmsm.core.bounds import RangeRule, range_bounds
+from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.references import ReferenceSplines

@@ -1,6 +1,6 @@
 """Python functions named by ``user_defined`` terms (``<function_name>``).
 
-A user function takes ``(ctx, term)`` - the :class:`~nmsm.tools.treatment.context.TreatmentContext`
+A user function takes ``(ctx, term)`` - the :class:`~nmsm.core.ocp.OcpContext`
 and the term (its extra settings elements are in ``term.options``, strings) - and returns a
 CasADi expression: a (K, 1) column on the collocation points for continuous costs and path
 constraints, a scalar for discrete costs and terminal constraints (use ``ctx.initial`` /

@@ -2,7 +2,7 @@
 
 Each family (``generalized_coordinate``, ``marker_position``, ...) is a :class:`Signal`
 that checks the term's names against the context (``bind``) and returns, on any
-:class:`~nmsm.tools.treatment.context.GridView`, the modeled column (n, 1) and the tracked
+:class:`~nmsm.core.ocp.OcpGrid`, the modeled column (n, 1) and the tracked
 column (n, 1). Cost, path-constraint and terminal-constraint classes of a family are thin
 wrappers over it (``*_tracking`` = tracked - modeled, ``*_deviation`` = modeled - tracked,
 ``*_value`` = modeled, ``*_periodicity`` = final - initial).
@@ -15,7 +15,7 @@ from typing import Any
 
 import attrs
 
-from nmsm.tools.treatment.term_bases import require_axis
+from nmsm.core.ocp import require_axis
 
 
 @attrs.frozen

@@ -1,4 +1,5 @@
-"""What a controller receives when it is built (:meth:`Controller.from_settings`).
+"""What a controller receives when it is built (:meth:`nmsm.core.plugin_bases.Controller.from_settings`),
+filled by the treatment tool.
 
 Times: the controller's control guesses are wanted at ``collocation_times`` and its state
 guesses (controllers with states) at ``node_times`` (s, on the reference time base:
@@ -9,14 +10,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import attrs
 import numpy as np
 
 from nmsm.errors import InputError
-from nmsm.tools.treatment.model_interface import TreatmentModel
-from nmsm.tools.treatment.references import ReferenceSplines
+
+if TYPE_CHECKING:  # the treatment tool's types, named in annotations only
+    from nmsm.tools.treatment.model_interface import TreatmentModel
+    from nmsm.tools.treatment.references import ReferenceSplines
 
 
 @attrs.define

@@ -1,0 +1,250 @@
+"""Conformance checks a term author runs on their own class: :func:`check_term`.
+
+In the manner of scikit-learn's ``check_estimator``::
+
+    from nmsm.testing import check_term
+    from my_plugin.terms import CoordinateLimitPenalty
+
+    def test_conforms():
+        check_term(CoordinateLimitPenalty, {"coordinate": "q0", "upper_limit": "0.2"})
+
+:func:`check_term` raises :class:`TermCheckError` saying what is wrong, and returns a
+:class:`TermCheckReport` of what it checked. ``nmsm plugins --check`` runs it on every
+registered term and constraint.
+
+Checks, for every term:
+
+* the class is usable from settings XML (decorated, ``type``, ``tools``, field types), has a
+  docstring, and a Treatment Optimization term declares its ``evaluation`` (it subclasses a
+  base of :mod:`nmsm.core.ocp`);
+* the example settings elements build at least one term (``from_spec``);
+* bad elements are refused with an :class:`~nmsm.errors.InputError`: an unknown element
+  (unless the term has an ``options`` field, which keeps them), ``max_allowable_error`` 0
+  (costs), ``min_error`` above ``max_error`` (constraints).
+
+For Treatment Optimization terms (TO, VO, DO), on a small synthetic problem (a two-link
+pendulum with a coupled coordinate; coordinates ``q0``, ``q1``, ``follower``, markers
+``tip_0``, ``tip_1``, ``follower_marker``, bodies ``link_0``, ``link_1``, torque controls
+``q0_moment``, ``q1_moment``; states at the tracked motion):
+
+* the term binds and builds (its quantity has the shape its evaluation requires);
+* its residuals are finite, and their exact (CasADi) derivative along a random direction
+  matches central finite differences;
+* a ``*_tracking`` term of the kinematics is zero where the motion is the tracked one.
+
+A term that needs what the pendulum has not (muscles, contact, synergies, a metabolic model)
+is reported as not built (``report.not_built`` names why); its declaration and settings
+checks still run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import attrs
+import numpy as np
+
+from nmsm.core.ocp import TREATMENT_TOOLS
+from nmsm.core.term import (
+    LIST_TO_SINGULAR,
+    ConstraintTerm,
+    CostTerm,
+    SourceRef,
+    Term,
+    TermSpec,
+    term_class_problems,
+)
+from nmsm.errors import InputError, NmsmError
+
+#: Values of required fields on the synthetic pendulum, used when the example does not give them.
+PENDULUM_VALUES: dict[str, str] = {
+    "coordinate": "q0",
+    "load": "q0_moment",
+    "marker": "tip_1",
+    "body": "link_1",
+    "axis": "x",
+    "controller": "q0_moment",
+}
+
+#: Names the pendulum has not (muscles, contact, synergies, user functions), used for required
+#: fields the example does not give: the settings checks run, and building reports why not.
+PLACEHOLDER_VALUES: dict[str, str] = {
+    "muscle": "muscle_0",
+    "hindfoot_body": "link_0",
+    "force": "ground_force_vx",
+    "moment": "ground_torque_z",
+    "synergy": "group_1",
+    "synergies": "group_1 group_2",
+    "function_name": "check_term_no_such_function",
+}
+
+#: Families whose ``*_tracking`` cost is zero on the tracked motion.
+_ZERO_AT_TRACKING = ("generalized_coordinate", "generalized_speed", "marker_position", "marker_velocity",
+                     "body_orientation")
+
+
+class TermCheckError(AssertionError):
+    """A term class fails a conformance check (the message names the class and the check)."""
+
+
+@attrs.define
+class TermCheckReport:
+    """What :func:`check_term` checked: ``passed`` (names of checks) and ``not_built`` (why
+    the term was not built on the synthetic problem, or None)."""
+
+    cls: type
+    passed: list[str] = attrs.field(factory=list)
+    not_built: str | None = None
+
+
+def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str | None = None) -> TermCheckReport:
+    """Run the conformance checks of the module docstring on term class ``cls``.
+
+    ``example``: settings elements -> text for the term's fields (what its ``<RCNLCostTerm>``
+    would hold, without ``type`` and ``is_enabled``; default: the class's ``check_example``);
+    fields missing from it take :data:`PENDULUM_VALUES` (and required ones
+    :data:`PLACEHOLDER_VALUES`). A required field still without a value stops the checks
+    after the declaration (``report.not_built`` says which). ``tool``: the tool to check for
+    (default: a treatment tool the class accepts, else its first tool).
+    """
+    report = TermCheckReport(cls)
+    name = f"{getattr(cls, '__module__', '?')}.{getattr(cls, '__qualname__', cls)}"
+    if not (isinstance(cls, type) and issubclass(cls, (CostTerm, ConstraintTerm))):
+        raise TermCheckError(f"{name} is not a subclass of nmsm.core.term.CostTerm or ConstraintTerm")
+    _check_declaration(cls, name, report)
+    tool = tool or (sorted(cls.tools & TREATMENT_TOOLS) or sorted(cls.tools))[0]
+    elements = _example_elements(cls, example)
+    missing = cls._missing_required({cls.aliases.get(e, e) for e in elements}
+                                    | {s for p, s in LIST_TO_SINGULAR.items() if p in elements})
+    if missing:
+        report.not_built = (f"no example value for required {', '.join(f'<{m}>' for m in missing)}: set "
+                            f"check_example on the class or pass check_term(cls, example={{...}})")
+        return report
+    terms = _check_settings(cls, name, elements, report)
+    if tool in TREATMENT_TOOLS:
+        _check_on_pendulum(cls, name, terms[0], tool, report)
+    else:
+        report.not_built = f"no synthetic problem for {tool} (declaration and settings checked)"
+    return report
+
+
+def _check_declaration(cls: type, name: str, report: TermCheckReport) -> None:
+    problems = term_class_problems(cls)
+    if problems:
+        raise TermCheckError(f"{name} " + "; ".join(problems))
+    if not cls.type:
+        raise TermCheckError(f"{name} sets no 'type' (its settings name)")
+    if not cls.tools:
+        raise TermCheckError(f"{name} accepts no tool (set tools: ClassVar[frozenset[str]])")
+    if not (cls.__doc__ or "").strip():
+        raise TermCheckError(f"{name} has no docstring (say what the quantity is, with its unit)")
+    if cls.tools & TREATMENT_TOOLS and getattr(cls, "evaluation", None) is None:
+        raise TermCheckError(f"{name} accepts {sorted(cls.tools & TREATMENT_TOOLS)} but declares no 'evaluation': "
+                             "subclass ContinuousCost, DiscreteCost, PathConstraint or TerminalConstraint "
+                             "from nmsm.core.ocp")
+    report.passed.append("declaration")
+
+
+def _example_elements(cls: type, example: Mapping[str, str] | None) -> dict[str, str]:
+    elements = dict(cls.check_example if example is None else example)
+    given = {cls.aliases.get(e, e) for e in elements}
+    given |= {single for plural, single in LIST_TO_SINGULAR.items() if plural in given}
+    fields = cls.xml_fields()
+    for field, text in PENDULUM_VALUES.items():
+        if field in fields and field not in given:
+            elements[field] = text
+    for field in cls._missing_required(given | set(elements)):
+        if field in PLACEHOLDER_VALUES:
+            elements[field] = PLACEHOLDER_VALUES[field]
+    return elements
+
+
+def _spec(cls: type, elements: Mapping[str, str]) -> TermSpec:
+    fields = {"type": cls.type, "is_enabled": "true", **elements}
+    return TermSpec(cls.kind, cls.type, fields, SourceRef("check_term.xml", 1))
+
+
+def _check_settings(cls: type, name: str, elements: dict[str, str], report: TermCheckReport) -> list[Term]:
+    try:
+        terms = cls.from_spec(_spec(cls, elements))
+    except InputError as exc:
+        raise TermCheckError(f"{name}: the example elements {elements} do not build a term ({exc}); "
+                             "pass check_term(cls, example={...}) with valid element texts") from exc
+    if not terms:
+        raise TermCheckError(f"{name}: from_spec built no term from {elements}")
+    report.passed.append("settings")
+    if cls.kind == "cost":
+        bad_values = {"max_allowable_error": "0"}
+    else:
+        bad_values = {"min_error": "2", "max_error": "1"}
+    wrongs = [bad_values]
+    if "options" not in cls.xml_fields():  # a term with ``options`` keeps unknown elements as its options
+        wrongs.insert(0, {"element_that_is_not_a_field": "1"})
+    for wrong in wrongs:
+        try:
+            cls.from_spec(_spec(cls, {**elements, **wrong}))
+        except InputError:
+            continue
+        raise TermCheckError(f"{name}: the settings elements {wrong} were accepted "
+                             "(expected an InputError naming them)")
+    report.passed.append("bad elements refused")
+    return terms
+
+
+def _check_on_pendulum(cls: type, name: str, term: Term, tool: str, report: TermCheckReport) -> None:
+    import casadi as cs
+
+    from nmsm.testing.pendulum_problem import build_pendulum_problem
+
+    built = build_pendulum_problem([], tool=tool)
+    problem, ctx = built.problem, built.context
+    try:
+        term.bind(ctx)
+    except InputError as exc:  # the term needs what the pendulum has not (bind said so)
+        report.not_built = str(exc)
+        return
+    try:
+        problem.add_term(term, ctx)
+    except NmsmError as exc:  # bound, but its quantity does not build (shape, a missing quantity, ...)
+        raise TermCheckError(f"{name}: building on the synthetic problem failed: {exc}") from exc
+    entries = [e for e in (problem.costs if cls.kind == "cost" else problem.constraints) if e.term is term]
+    if not entries:
+        raise TermCheckError(f"{name}: the built problem has no entry of the term")
+    expression = cs.vertcat(*[e.residuals if cls.kind == "cost" else e.expression for e in entries])
+    x = problem.scaled_vector()
+    p = problem.parameter_vector()
+    lower, upper = problem.bounds_scaled()
+    tracked = np.clip(problem.initial_scaled(), lower, upper)  # states on the tracked motion
+    rng = np.random.default_rng(0)
+    x0 = np.clip(tracked + 0.05 * rng.standard_normal(tracked.size), lower, upper)
+    values = problem.parameter_values()
+    f = cs.Function("f", [x, p], [expression])
+    jac = cs.Function("j", [x, p], [cs.jacobian(expression, x)])
+    value = np.asarray(f(x0, values)).ravel()
+    if not np.all(np.isfinite(value)):
+        raise TermCheckError(f"{name}: non-finite values on the synthetic problem")
+    report.passed.append("built, finite")
+    direction = rng.standard_normal(x0.size)
+    direction /= np.linalg.norm(direction)
+    h = 1e-6
+    forward = np.asarray(f(x0 + h * direction, values)).ravel()
+    backward = np.asarray(f(x0 - h * direction, values)).ravel()
+    fd = (forward - backward) / (2 * h)
+    ad = np.asarray(jac(x0, values)) @ direction
+    scale = max(1.0, float(np.max(np.abs(ad), initial=0.0)))
+    if not np.allclose(ad, fd, rtol=1e-4, atol=1e-5 * scale):
+        worst = int(np.argmax(np.abs(ad - fd)))
+        raise TermCheckError(f"{name}: exact derivative {ad[worst]:.6g} differs from finite differences "
+                             f"{fd[worst]:.6g} (row {worst})")
+    report.passed.append("derivatives")
+    family = cls.type[: -len("_tracking")] if cls.type.endswith("_tracking") else None
+    if family in _ZERO_AT_TRACKING:
+        at_tracked = np.asarray(f(tracked, values)).ravel()
+        if np.max(np.abs(at_tracked), initial=0.0) > 1e-6:
+            raise TermCheckError(f"{name}: not zero on the tracked motion (max |residual| "
+                                 f"{np.max(np.abs(at_tracked)):.3g})")
+        report.passed.append("zero at perfect tracking")
+
+
+__all__ = ["PENDULUM_VALUES", "PLACEHOLDER_VALUES", "TermCheckError", "TermCheckReport", "check_term"]
