@@ -177,7 +177,8 @@ def walk(
         spelled.append(found[0])
         renamed = True
     else:
-        return Walk(current, "/".join(spelled), renamed, True)
+        if _kind_ok(current, kind):
+            return Walk(current, "/".join(spelled), renamed, True)
     if not partial:
         return None
     rest = parts[len(spelled):]

@@ -188,3 +188,16 @@ def test_explicit_base_with_dot_dot_and_wrong_case(study: Path) -> None:
     assert found == study / "Models" / "Subject.osim"
     with pytest.raises(InputError, match=r"relative paths are relative to"):
         resolve_path("..\\models\\SUBJECT.osim", settings_file=settings, base=base, kind="file")
+
+
+@pytest.mark.parametrize("text", ["/", ".", "..", "up/.."])
+def test_a_folder_reached_by_dots_or_the_root_is_no_file(tmp_path, text):
+    """A path whose last part is ``..``, ``.`` or the root names a folder: asked for a file, it
+    is not found (it was returned as the file, and reading it failed without naming the
+    settings file)."""
+    settings = tmp_path / "pipeline" / "p.xml"
+    (tmp_path / "pipeline" / "up").mkdir(parents=True)
+    settings.write_text("<x/>")
+    with pytest.raises(InputError, match=r"p\.xml:3: <settings_file>: .* not found"):
+        resolve_path(text, settings_file=settings, line=3, element="settings_file", kind="file")
+    assert resolve_path(text, settings_file=settings, line=3, element="settings_file", kind="dir").is_dir()
