@@ -25,12 +25,15 @@ import attrs
 
 from nmsm.errors import InputError
 
-BASE_GB = 0.6
-FUNCTION_GB = 0.012
-POINT_GB = 0.0001
-STATE_WORK = 1.0
-MUSCLE_WORK = 2.0
-SPRING_WORK = 1.0
+BASE_GB = 0.18
+FUNCTION_GB = 0.0131
+POINT_GB = 7.25e-5
+#: work of a state coordinate, a muscle and a contact spring, relative to a muscle: the SX
+#: instructions each adds to the per-point functions (a muscle's surrogate geometry and Hill
+#: force, a spring's position, velocity and force, a coordinate's share of the inverse dynamics)
+STATE_WORK = 0.3
+MUSCLE_WORK = 1.0
+SPRING_WORK = 1 / 3
 
 
 @attrs.frozen
