@@ -28,12 +28,12 @@ from nmsm.errors import InputError
 BASE_GB = 0.18
 FUNCTION_GB = 0.0131
 POINT_GB = 7.25e-5
-#: work of a state coordinate, a muscle and a contact spring, relative to a muscle: the SX
-#: instructions each adds to the per-point functions (a muscle's surrogate geometry and Hill
-#: force, a spring's position, velocity and force, a coordinate's share of the inverse dynamics)
+#: work of a state coordinate, a muscle and a contact spring, relative to a muscle (a state
+#: coordinate: its share of the inverse dynamics' SX instructions; a spring: what the
+#: full-body two-foot contact case needs at least, see docs/treatment.md "Scale")
 STATE_WORK = 0.3
 MUSCLE_WORK = 1.0
-SPRING_WORK = 1 / 3
+SPRING_WORK = 2.0
 
 
 @attrs.frozen
