@@ -64,8 +64,8 @@ class TreatmentOptions:
     ``evaluate_only``: build, evaluate the cost at the
     starting point, do not solve. ``accept_unconverged``: write the results of a solve that
     did not converge, stamped as unconverged (:mod:`nmsm.core.unconverged`), instead of only
-    its last iterate. ``check_memory``: before building, stop with an
-    :class:`InputError` naming the dominant dimension when the problem's estimated memory
+    its last iterate. ``check_memory``: before building a problem to solve, stop
+    with an :class:`InputError` naming the dominant dimension when its estimated memory
     (:mod:`nmsm.tools.treatment.memory`) exceeds what the machine has available.
     """
 
@@ -316,7 +316,7 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     messages = _formulation_warnings(tool, states, terms, controllers)
     for message in messages:
         warnings.warn(f"{settings.settings_file}: {message}", stacklevel=2)
-    if options.check_memory:
+    if options.check_memory and not options.evaluate_only:  # the estimate is the solve's
         check_memory(memory_estimate(data, mesh), settings.settings_file)
     built = build_problem(data, mesh, state_setup, terms, name=f"{tool}_{settings.trial_name}",
                           normalize_cost_by_term_type=settings.normalize_cost_by_term_type,

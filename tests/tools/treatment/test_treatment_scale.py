@@ -101,3 +101,18 @@ def test_a_problem_too_big_for_the_memory_names_its_dominant_dimension(tmp_path:
     with pytest.raises(InputError, match=r"grows with the springs \(900 contact springs\)"):
         check_memory(many_springs, settings, available=1.0)
     check_memory(MemoryEstimate(points=100, states=31, muscles=86, springs=0), settings, available=1e3)
+
+
+def test_run_stops_before_building_when_the_estimate_does_not_fit(shared_data: Path, tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    import nmsm.tools.treatment.memory as memory
+    from nmsm.errors import InputError
+
+    monkeypatch.setattr(memory, "available_gigabytes", lambda: 0.01)
+    settings = shared_data / TORQUE_TO
+    with warnings.catch_warnings(), pytest.raises(InputError, match="the problem needs about") as error:
+        warnings.simplefilter("ignore")
+        run_settings(settings, results_directory=tmp_path / "results", print_level=0)
+    assert str(settings) in str(error.value)
+    assert not (tmp_path / "results").exists()
+    assert _evaluate(settings).initial_cost >= 0  # evaluating a start builds no solver: not checked
