@@ -162,7 +162,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             if own_command_line:
                 _ignore_late_interrupts()
             return status
-        print("nmsm: stopped; the interrupted task wrote nothing, finished tasks and stages are kept", file=sys.stderr)
+        print("nmsm: stopped; the interrupted task wrote no results (a treatment solve keeps its last iterate in "
+              "<results>/last_iterate/), finished tasks and stages are kept", file=sys.stderr)
         return 130
     return status
 

@@ -64,6 +64,8 @@ class SynergyController(Controller):
 
     type: ClassVar[str] = "synergy"
     settings_element: ClassVar[str] = "RCNLSynergyController"
+    #: lift the activations ``C W`` into design variables when the vectors are optimized
+    lift_activations: ClassVar[bool] = True
 
     def __init__(self, settings: Any, setup: ControllerSetup) -> None:
         self.setup = setup
@@ -195,9 +197,10 @@ class SynergyController(Controller):
             start = start / normalization_factors(start, self.method, self.norm_value)[:, None]
         initial = start[blocks]
         values = problem.variable(WEIGHTS_PARAMETER, np.clip(initial, 0, self.norm_value), 0.0, self.norm_value)
-        W = cs.MX(*self.weights0.shape)
-        for k, (i, j) in enumerate(idx):
-            W[int(i), int(j)] = values[k]
+        S, M = self.weights0.shape
+        flat = np.ravel_multi_index((idx[:, 0], idx[:, 1]), (S, M), order="F")
+        placement = cs.DM(cs.Sparsity.triplet(S * M, len(idx), flat.tolist(), list(range(len(idx)))), 1.0)
+        W = cs.reshape(cs.mtimes(placement, values), S, M)
         self._weights_expr = W
         # gauge: A = C W is unchanged by (C a, W / a), which leaves IPOPT a flat direction per
         # synergy; fixing each vector's norm as the output normalization will (sum or
@@ -246,7 +249,15 @@ class SynergyController(Controller):
         return cs.horzcat(*[view.control(PREFIX + name) * self.activation_scale[name] for name in self.synergy_names])
 
     def muscle_activations(self, view: Any) -> cs.MX:
-        return view.cached(f"synergy_activations:{id(self)}", lambda v: self.synergy_activations(v) @ self._weights_expr)
+        """(n, M) ``C W``; with optimized synergy vectors, on the integration grid, lifted
+        into design variables equal to it (:meth:`GridView.lifted`), so each point's muscle
+        functions see its activations instead of the vectors shared by all points."""
+        def product(v: Any) -> cs.MX:
+            return self.synergy_activations(v) @ self._weights_expr
+
+        if self.optimize_weights and self.lift_activations and getattr(view, "is_integration_grid", False):
+            return view.lifted("synergy_activations", product, lower=0.0)
+        return view.cached(f"synergy_activations:{id(self)}", product)
 
     def _muscle_outputs(self, view: Any) -> list[cs.MX]:
         return view.cached(f"synergy_muscles:{id(self)}",

@@ -5,7 +5,9 @@ Python callback) and returns normally with the status ``NonIpopt_Exception_Throw
 would then treat the interrupted iterate like any unconverged one and write it as results.
 :func:`interrupt_after_solve` records the signal while the solve runs and raises
 ``KeyboardInterrupt`` once the solver has returned, so staged results are discarded
-(:class:`nmsm.core.results.ResultsDirectory`) and ``nmsm`` exits with status 130.
+(:class:`nmsm.core.results.ResultsDirectory`) and ``nmsm`` exits with status 130. A back
+end that kept the last iterate raises :class:`SolveInterrupted` with it, so a tool can
+write it apart from results (treatment: ``<results>/last_iterate/``).
 """
 
 from __future__ import annotations
@@ -15,6 +17,16 @@ import signal
 import threading
 from collections.abc import Iterator
 from types import FrameType
+from typing import Any
+
+
+class SolveInterrupted(KeyboardInterrupt):
+    """A stop during a solve, carrying what the solver had reached: ``solution`` (the
+    back end's :class:`~nmsm.core.problem.Solution` at the last iterate, not converged)."""
+
+    def __init__(self, message: str, solution: Any = None) -> None:
+        super().__init__(message)
+        self.solution = solution
 
 
 @contextlib.contextmanager

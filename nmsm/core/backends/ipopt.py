@@ -16,7 +16,7 @@ import numpy as np
 
 from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
-from nmsm.core.interrupts import interrupt_after_solve
+from nmsm.core.interrupts import SolveInterrupted, interrupt_after_solve
 from nmsm.core.solution import Solution
 from nmsm.core.progress import SolveProgress, solve_progress
 
@@ -82,42 +82,62 @@ def solve_ipopt(
     for key, value in (ipopt_options or {}).items():
         opts[f"ipopt.{key}"] = value
     progress = solve_progress(problem.name) if int(print_level) == 0 else None
-    if progress is not None:  # IPOPT silent: a progress line every few seconds instead
-        opts["iteration_callback"] = _ProgressCallback(progress, xs.numel(), g.numel(), ps.numel(), lbg, ubg)
+    callback = _IterateCallback(progress, xs.numel(), g.numel(), ps.numel(), lbg, ubg)
+    opts["iteration_callback"] = callback  # progress lines when IPOPT is silent; the last iterate for a stop
     opts.update(casadi_options or {})
     solver = cs.nlpsol(function_name(problem.name or "nlp"), "ipopt", nlp, opts)
     lo, hi = problem.bounds_scaled()
     x0 = problem.initial_scaled() if initial_guess is None else np.asarray(initial_guess, dtype=float)
     x0 = np.clip(x0, lo, hi)
     start = time.perf_counter()
-    with interrupt_after_solve():  # Ctrl-C: KeyboardInterrupt, not an unconverged "result"
-        result = solver(x0=x0, p=problem.parameter_values(), lbx=lo, ubx=hi, lbg=lbg, ubg=ubg)
+    stop: KeyboardInterrupt | None = None
+    try:
+        with interrupt_after_solve():  # Ctrl-C: KeyboardInterrupt, not an unconverged "result"
+            result = solver(x0=x0, p=problem.parameter_values(), lbx=lo, ubx=hi, lbg=lbg, ubg=ubg)
+    except KeyboardInterrupt as exc:
+        if callback.x is None:
+            raise
+        stop = exc
     wall = time.perf_counter() - start
     stats = solver.stats()
-    x_opt = np.asarray(result["x"].full()).ravel()
-    term_costs = problem.term_costs(x_opt)
-    return Solution(
+    if stop is not None:  # the last iterate IPOPT reported, not what it returned on the way out
+        x_opt = callback.x
+        cost = float(np.asarray(problem.evaluate(problem.objective(), x_opt)).ravel()[0])
+        success, status = False, "Stopped_By_SIGINT"
+    else:
+        x_opt = np.asarray(result["x"].full()).ravel()
+        cost = float(result["f"])
+        success, status = bool(stats.get("success", False)), str(stats.get("return_status", "unknown"))
+    solution = Solution(
         values=problem.unpack(x_opt),
-        cost=float(result["f"]),
-        term_costs=term_costs,
-        success=bool(stats.get("success", False)),
-        status=str(stats.get("return_status", "unknown")),
-        iterations=int(stats.get("iter_count", -1)),
+        cost=cost,
+        term_costs=problem.term_costs(x_opt),
+        success=success,
+        status=status,
+        iterations=int(stats.get("iter_count", callback.iterations)) if stop is None else callback.iterations,
         wall_time=wall,
         backend="ipopt",
         x_scaled=x_opt,
         constraints=problem.constraint_report(x_opt),
         history=ConvergenceHistory.from_ipopt_stats(stats),
     )
+    if stop is not None:
+        raise SolveInterrupted(str(stop) or "stopped by SIGINT during the solve", solution) from stop
+    return solution
 
 
-class _ProgressCallback(cs.Callback):
-    """CasADi ``iteration_callback``: each IPOPT iterate's cost and largest constraint
-    violation go to a :class:`~nmsm.core.progress.SolveProgress`."""
+class _IterateCallback(cs.Callback):
+    """CasADi ``iteration_callback``: keeps each IPOPT iterate (scaled ``x``, :attr:`x`;
+    :attr:`iterations` is the last one's number) and, given a
+    :class:`~nmsm.core.progress.SolveProgress`, reports its cost and largest constraint
+    violation there."""
 
-    def __init__(self, progress: SolveProgress, nx: int, ng: int, n_p: int, lbg: np.ndarray, ubg: np.ndarray) -> None:
+    def __init__(self, progress: SolveProgress | None, nx: int, ng: int, n_p: int, lbg: np.ndarray,
+                 ubg: np.ndarray) -> None:
         cs.Callback.__init__(self)
         self.progress = progress
+        self.x: np.ndarray | None = None
+        self.iterations = -1  # the first call reports iteration 0
         self.sizes = {"x": nx, "f": 1, "g": ng, "lam_x": nx, "lam_g": ng, "lam_p": n_p}
         self.lbg = np.asarray(lbg, dtype=float).ravel()
         self.ubg = np.asarray(ubg, dtype=float).ravel()
@@ -139,7 +159,9 @@ class _ProgressCallback(cs.Callback):
         return cs.Sparsity.dense(self.sizes[cs.nlpsol_out(i)], 1)
 
     def eval(self, arg: list[cs.DM]) -> list[int]:
-        if self.progress.tick():
+        self.x = np.asarray(arg[cs.nlpsol_out().index("x")]).ravel().copy()
+        self.iterations += 1
+        if self.progress is not None and self.progress.tick():
             f = float(arg[cs.nlpsol_out().index("f")])
             g = np.asarray(arg[cs.nlpsol_out().index("g")]).ravel()
             violation = float(np.max(np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0))) if g.size else None

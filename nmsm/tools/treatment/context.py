@@ -89,6 +89,11 @@ class GridView:
     def time(self) -> cs.MX:
         return self._q.trajectory.times(self.grid)
 
+    @property
+    def is_integration_grid(self) -> bool:
+        """True on the grid of the cost integrals (the collocation points)."""
+        return self.grid == self._q.trajectory.integration_grid
+
     # ---- kinematics -----------------------------------------------------------------------
     def positions(self) -> cs.MX:
         return self._q.kinematics(self.grid)[0]
@@ -209,6 +214,30 @@ class GridView:
     def cached(self, key: str, compute: Callable[[GridView], cs.MX]) -> cs.MX:
         """``compute(self)`` once per grid and ``key`` (for quantities added by plugins)."""
         return self._q.cache((self.grid, "plugin", key), lambda: compute(self))
+
+    def lifted(self, key: str, compute: Callable[[GridView], cs.MX], lower: float = -np.inf,
+               upper: float = np.inf) -> cs.MX:
+        """``compute(self)`` (an (n, m) expression) replaced by an (n, m) block of new
+        design variables ``lifted:<key>@<grid>``, equal to it by an equality constraint
+        block of the same name and starting at its value at the initial guess; ``lower``,
+        ``upper``: bounds the expression itself keeps (so the variables keep them too).
+
+        The problem is the same; what changes is its derivatives' structure: a quantity
+        that couples variables shared by every row (e.g. synergy vectors) with each row's
+        variables becomes an input of the row's own functions, so the Hessian of the
+        Lagrangian keeps one block per row instead of dense rows and columns.
+        """
+        def make() -> cs.MX:
+            expression = cs.MX(compute(self))
+            problem = self._q.trajectory.problem
+            name = f"lifted:{key}@{self.grid}"
+            lo, hi = problem.bounds_scaled()
+            start = problem.evaluate(expression, np.clip(problem.initial_scaled(), lo, hi))
+            variable = problem.variable(name, np.clip(start, lower, upper), lower, upper, shape=expression.shape,
+                                        scale=np.ones(expression.shape))
+            problem.add_constraint(name, variable - expression, 0.0, 0.0)
+            return variable
+        return self._q.cache((self.grid, "lifted", key), make)
 
     # ---- whole body, per-foot ground reactions, centre of pressure, metabolic rate -------------
     # (the DO goals' quantities: terms in nmsm/terms/treatment/angular_momentum.py,

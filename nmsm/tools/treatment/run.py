@@ -12,21 +12,26 @@ Options (keyword arguments) are the fields of
 (return the cost of the starting point without solving) and ``write_results``.
 
 Results are staged and moved into the results folder only when the solve succeeded. A
-failed solve writes its last iterate and a diagnosis into ``<results>/last_iterate/``, moves
+failed solve, or one stopped with Ctrl-C (which then propagates as ``KeyboardInterrupt``),
+writes its last iterate and a diagnosis into ``<results>/last_iterate/``, moves
 the results an earlier run wrote there for the same trial into ``<results>/superseded/``
 (:meth:`~nmsm.core.results.ResultsDirectory.retire`) and raises
 :class:`~nmsm.errors.SolverError`. The IPOPT log is removed from the results folder however
 the run ends (a copy goes with the results or the last iterate). A results folder that is
 one of the input folders (tracked quantities, initial guess, guess) is refused before
-solving, and the input data files are never overwritten.
+solving, and the input data files are never overwritten. A starting point that violates a
+constraint by more than :data:`~nmsm.tools.treatment.diagnosis.FAR_FROM_CONSISTENT` (scaled
+units) is reported with its worst constraint block, state or load and collocation point.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -34,11 +39,12 @@ import attrs
 import numpy as np
 
 from nmsm.core.console import announce, console_enabled, summarize
+from nmsm.core.interrupts import SolveInterrupted
 from nmsm.core.problem import Solution
 from nmsm.core.results import SUPERSEDED, ResultsDirectory
 from nmsm.core.unconverged import ACCEPT_OPTION, status_hints, unconverged_note, warn_accepted, write_last_iterate
 from nmsm.errors import InputError, SolverError
-from nmsm.tools.treatment.diagnosis import convergence_summary
+from nmsm.tools.treatment.diagnosis import FAR_FROM_CONSISTENT, convergence_summary, worst_constraint
 from nmsm.tools.treatment.solution import TreatmentSolution
 from nmsm.tools.treatment.tool import Prepared, TreatmentOptions, prepare
 
@@ -221,6 +227,11 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
 
     x0 = np.clip(x0, lo, hi)
     initial_cost = float(np.asarray(problem.evaluate(problem.objective(), x0)).ravel()[0])
+    worst = worst_constraint(prepared.built, x0)
+    if worst is not None and worst.violation > FAR_FROM_CONSISTENT:
+        message = f"{settings.settings_file}: {worst.message()}"
+        warnings.warn(message, stacklevel=2)
+        prepared.warnings.append(message)
     trial = settings.trial_name
     constraint_rows = sum(int(np.size(c.lower)) for c in problem.constraints)
     announce(prepared.tool, settings=path, model=settings.input_model_file, trials=[trial],
@@ -270,7 +281,14 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
     iterate, after moving the earlier run's results of the trial into ``superseded/``."""
     trial = settings.trial_name
     log = log_dir / f"{trial}_ipopt.log" if log_dir is not None else None
-    solution = prepared.built.problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
+    try:
+        solution = prepared.built.problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
+    except SolveInterrupted as stop:
+        if results is not None and stop.solution is not None:
+            saved = _write_stopped(prepared, stop.solution, trial, results, log)
+            print(f"nmsm: {settings.settings_file}: stopped after {stop.solution.iterations} iterations; the last "
+                  f"iterate and a diagnosis are in {saved}", file=sys.stderr)
+        raise
     tsol = TreatmentSolution(prepared.built, solution, trial)
     summary = convergence_summary(prepared.built, solution)
     files: list[Path] = []
@@ -323,8 +341,30 @@ def _keep_last_iterate(settings: Any, prepared: Prepared, solution: Solution, ts
                       last_iterate_path=str(saved) if saved is not None else None)
 
 
+def _write_stopped(prepared: Prepared, solution: Solution, trial: str, results: ResultsDirectory,
+                   log: Path | None) -> Path:
+    """A solve stopped with Ctrl-C: its last iterate and the diagnosis into
+    ``<results>/last_iterate/`` (the trial's earlier results stay where they are); returns
+    that folder."""
+    from nmsm.tools.treatment.outputs import write_solution
+
+    tsol = TreatmentSolution(prepared.built, solution, trial)
+    summary = convergence_summary(prepared.built, solution)
+
+    def write(folder: Path) -> None:
+        write_solution(folder, tsol, summary=summary)
+        if log is not None and log.is_file():
+            shutil.copy2(log, folder / log.name)
+
+    return write_last_iterate(results, write, _diagnosis(prepared, solution, summary),
+                              unconverged_note([f"was stopped (Ctrl-C) after {solution.iterations} iterations"]))
+
+
 def _diagnosis(prepared: Prepared, solution: Solution, summary: str) -> str:
     hints = status_hints(solution.status, "<setup_nlp_max_iterations>")
+    if solution.status == "Stopped_By_SIGINT":
+        hints.insert(0, "The run was stopped (Ctrl-C) before IPOPT converged: this is the last iterate it reached, "
+                        "not a result.")
     if prepared.warnings:
         hints.append("Input warnings:\n  " + "\n  ".join(prepared.warnings))
     return "Diagnosis\n=========\n" + ("\n".join(hints) + "\n\n" if hints else "") + summary + "\n"

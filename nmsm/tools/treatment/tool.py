@@ -25,6 +25,7 @@ from nmsm.core.bounds import RangeRule, check_guess_within, range_bounds
 from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
 from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files
+from nmsm.tools.treatment.memory import MemoryEstimate, check_memory
 from nmsm.tools.treatment.model_interface import TreatmentModel
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.references import ReferenceSplines
@@ -64,7 +65,9 @@ class TreatmentOptions:
     ``evaluate_only``: build, evaluate the cost at the
     starting point, do not solve. ``accept_unconverged``: write the results of a solve that
     did not converge, stamped as unconverged (:mod:`nmsm.core.unconverged`), instead of only
-    its last iterate.
+    its last iterate. ``check_memory``: before building a problem to solve, stop
+    with an :class:`InputError` naming the dominant dimension when its estimated memory
+    (:mod:`nmsm.tools.treatment.memory`) exceeds what the machine has available.
     """
 
     results_directory: Path | None = None
@@ -84,6 +87,7 @@ class TreatmentOptions:
     evaluate_only: bool = False
     write_results: bool = True
     accept_unconverged: bool = False
+    check_memory: bool = True
 
 
 @attrs.define
@@ -208,6 +212,15 @@ def _state_setup(settings: Any, files: TreatmentFiles, guess_files: TreatmentFil
     return StateSetup(np.r_[lo_q, lo_v], np.r_[hi_q, hi_v], lo_a, hi_a, guess, accel_guess)
 
 
+def memory_estimate(data: TreatmentData, mesh: Any) -> MemoryEstimate:
+    """The problem's memory estimate from its collocation points, state coordinates, muscles
+    and contact springs (a contact model without springs counts as one)."""
+    muscles = {m for c in data.controllers for m in c.muscle_names()}
+    springs = sum(int(c.spring_count()) if hasattr(c, "spring_count") else 1 for c in data.contact_models)
+    return MemoryEstimate(points=mesh.n_collocation, states=len(data.state_coordinates), muscles=len(muscles),
+                          springs=springs)
+
+
 def _formulation_warnings(tool: str, states: tuple[str, ...], terms: Sequence[Term],
                           controllers: Sequence[Any]) -> list[str]:
     """'neither controlled nor tracked' / VO 'both' diagnostics for state coordinates."""
@@ -304,6 +317,8 @@ def prepare(settings: Any, solver_settings: Any, options: TreatmentOptions | Non
     messages = _formulation_warnings(tool, states, terms, controllers)
     for message in messages:
         warnings.warn(f"{settings.settings_file}: {message}", stacklevel=2)
+    if options.check_memory and not options.evaluate_only:  # the estimate is the solve's
+        check_memory(memory_estimate(data, mesh), settings.settings_file)
     built = build_problem(data, mesh, state_setup, terms, name=f"{tool}_{settings.trial_name}",
                           normalize_cost_by_term_type=settings.normalize_cost_by_term_type,
                           parallel=options.parallel, declare_extra=declare_extra)

@@ -35,12 +35,15 @@ def test_stress_problem_size(built):
     points = 5 * 4  # coarse: 5 intervals x 4 collocation points
     states, synergies, torques = 31, 10, 11
     weights = 2 * 43 * 5  # each leg's 43 muscles x 5 synergies, optimized
-    assert problem.n_variables == 2 * states * (points + 1) + (states + synergies + torques) * points + weights
+    activations = 2 * 43 * points  # lifted: the activations C W on the collocation points
+    assert problem.n_variables == (2 * states * (points + 1) + (states + synergies + torques) * points + weights
+                                   + activations)
     blocks = {c.name.split(":")[0]: 0 for c in built.solution.constraints}
     for c in built.solution.constraints:
         blocks[c.name.split(":")[0]] += c.size
     assert blocks == {"dynamics_defects": 2 * states * points, "synergy_vector_normalization": synergies,
-                      "kinetic_consistency": 25 * points, "root_segment_residual_load": 6 * points}
+                      "kinetic_consistency": 25 * points, "root_segment_residual_load": 6 * points,
+                      "lifted": activations}
     names = set(built.solution.term_costs)
     assert {f"muscle_activation_tracking:{m}" for m in ("soleus_r", "soleus_l", "glmax1_l")} <= names
     assert {f"external_force_tracking:ground_force_{p}_vy" for p in (1, 2)} <= names

@@ -112,7 +112,20 @@ def _away(built: Any, seed: int = 11, size: float = 0.15) -> np.ndarray:
     """A point of the problem away from the initial guess (the tracked motion), within bounds."""
     problem = built.problem
     x = problem.initial_scaled() + size * np.random.default_rng(seed).standard_normal(problem.n_variables)
-    return np.clip(x, *problem.bounds_scaled())
+    return _lifted_equal(built, np.clip(x, *problem.bounds_scaled()))
+
+
+def _lifted_equal(built: Any, x: np.ndarray) -> np.ndarray:
+    """``x`` with the lifted variables (GridView.lifted) set equal to their expressions."""
+    problem = built.problem
+    x = np.array(x, dtype=float)
+    for constraint in problem.constraints:
+        if constraint.name.startswith("lifted:"):
+            variable = problem.variables[constraint.name]
+            value = variable.from_scaled(x[variable.start:variable.start + variable.size])
+            gap = np.asarray(problem.evaluate(constraint.expression, x)).reshape(variable.shape, order="F")
+            x[variable.start:variable.start + variable.size] = variable.to_scaled(value - gap)
+    return x
 
 
 def _ev(built: Any, expression: Any, x: np.ndarray) -> np.ndarray:
@@ -864,7 +877,7 @@ def test_synergy_activation_scale_and_outputs(shared_data: Path) -> None:
     np.testing.assert_allclose(commands, C * W.sum(axis=1)[None, :], rtol=1e-12)
     np.testing.assert_allclose(activations, C @ W, rtol=1e-10, atol=1e-14)
     scaled = _kick_with(shared_data, halve_second)
-    A_half = _ev(scaled, scaled.context.muscle_activations(), x)
+    A_half = _ev(scaled, scaled.context.muscle_activations(), _lifted_equal(scaled, x))
     np.testing.assert_allclose(A - A_half, 0.5 * np.outer(C[:, 1], W[1]), rtol=1e-9, atol=1e-12)
 
 
