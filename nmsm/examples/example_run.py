@@ -168,10 +168,7 @@ def run_example(folder: str | os.PathLike[str] = "nmsm_example", *, until: str |
         subject = make_subject(folder, log=log)
     stages = STAGES if until is None else STAGES[: STAGES.index(until) + 1]
     pipeline = write_example_pipeline(subject, folder, n_synergies=N_SYNERGIES, stages=stages)
-    # GCP's tasks stop at their <max_iterations> residual evaluations (as the tutorials' do) before
-    # scipy's tolerances: the example accepts those results, stamped UNCONVERGED (docs/pipeline.md)
-    accepted = {"gcp": {"accept_unconverged": True}} if "gcp" in stages else {}
-    run = run_pipeline_file(pipeline, log=log, stage_options=accepted)
+    run = run_pipeline_file(pipeline, log=log)
     ran = {s.name for s in run.stages if s.status not in (DISABLED, NOT_SELECTED)}
     times = {s.name: s.wall_time for s in run.stages if s.name in ran}
     checks = _checks(folder, run.results_directory, ran)

@@ -138,21 +138,54 @@ def test_nmsm_run_exits_1_and_accepts_with_the_option(shared_data: Path, tmp_pat
 
 def test_the_pipeline_option_reaches_every_optimizing_stage() -> None:
     """``nmsm pipeline --accept-unconverged``: the solving stages get ``accept_unconverged``
-    (other stages nothing), without changing the caller's stage options."""
+    (other stages nothing), without changing the caller's stage options; without it only the
+    stages whose ``<accept_unconverged>`` is true."""
     from types import SimpleNamespace
 
     from nmsm.tools.pipeline.runner import _with_accept_unconverged
 
-    def stage(name: str, tool: str) -> SimpleNamespace:
-        return SimpleNamespace(name=name, kind=SimpleNamespace(tool_element=tool))
+    def stage(name: str, tool: str, accept: bool = False) -> SimpleNamespace:
+        return SimpleNamespace(name=name, kind=SimpleNamespace(tool_element=tool), accept_unconverged=accept)
 
     spec = SimpleNamespace(stages=[stage("jmp", "JointModelPersonalizationTool"),
                                    stage("analysis", "ModelAnalysisTool"),
-                                   stage("gcp", "GroundContactPersonalizationTool"),
+                                   stage("gcp", "GroundContactPersonalizationTool", accept=True),
                                    stage("to", "TrackingOptimizationTool")])
     given = {"gcp": {"max_iterations": 5}}
-    assert _with_accept_unconverged(spec, given, False) is given
+    assert _with_accept_unconverged(spec, given, False) == {"gcp": {"max_iterations": 5, "accept_unconverged": True}}
     options = _with_accept_unconverged(spec, given, True)
     assert options == {"jmp": {"accept_unconverged": True}, "to": {"accept_unconverged": True},
                        "gcp": {"max_iterations": 5, "accept_unconverged": True}}
     assert given == {"gcp": {"max_iterations": 5}}
+
+
+def _one_stage_pipeline(folder: Path, tool: str, accept: str) -> Path:
+    path = folder / "pipeline.xml"
+    path.write_text(f"""<NMSMPipelineDocument Version="1.5.3"><PipelineTool name="p">
+  <results_directory>results</results_directory>
+  <StageList>
+    <Stage name="s">
+      <accept_unconverged>{accept}</accept_unconverged>
+      <{tool}/>
+    </Stage>
+  </StageList>
+</PipelineTool></NMSMPipelineDocument>
+""")
+    return path
+
+
+def test_a_stage_accepts_unconverged_results_by_its_element(tmp_path: Path) -> None:
+    """``<accept_unconverged>`` of a pipeline ``<Stage>``: read as a boolean, only in a stage
+    that solves an optimization, each refusal at its line."""
+    from nmsm.errors import InputError
+    from nmsm.tools.pipeline.pipeline_file import read_pipeline
+
+    stage = read_pipeline(_one_stage_pipeline(tmp_path, "GroundContactPersonalizationTool", "true")).stages[0]
+    assert stage.accept_unconverged
+    assert not read_pipeline(_one_stage_pipeline(tmp_path, "GroundContactPersonalizationTool", "")).stages[0] \
+        .accept_unconverged
+    for tool, accept, message in (("GroundContactPersonalizationTool", "perhaps", "not a boolean"),
+                                  ("ModelAnalysisTool", "true", "solves no optimization")):
+        with pytest.raises(InputError, match=message) as info:
+            read_pipeline(_one_stage_pipeline(tmp_path, tool, accept))
+        assert info.value.line == 5 and info.value.element == "<accept_unconverged>"

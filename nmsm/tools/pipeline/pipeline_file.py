@@ -32,13 +32,14 @@ from lxml import etree
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
 from nmsm.io.settings.document import ROOT, check_version, elements, parse_settings_xml, to_bool
+from nmsm.tools.dispatch import SOLVING_TOOLS
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS
 from nmsm.tools.pipeline.kinds import StageKind, kind_for_element
 from nmsm.io.xml_input import element_text
 from nmsm.tools.pipeline.stage_settings import StageSettings
 
 TOOL = "PipelineTool"
-_STAGE_ELEMENTS = ("is_enabled", "settings_file", "keep_settings_inputs")
+_STAGE_ELEMENTS = ("is_enabled", "settings_file", "keep_settings_inputs", "accept_unconverged")
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: longest stage name: its results folder's aside copy ``.<name>.earlier`` is one path
 #: component, at most 255 bytes on common file systems (a longer name was an OSError
@@ -52,6 +53,9 @@ class StageSpec:
 
     ``keep``: settings elements the runner must leave as the settings give them
     (``keep_settings_inputs``), e.g. ``input_model_file`` for a tool run on another model.
+    ``accept_unconverged``: the stage writes its results although its solve stopped before
+    its stopping criterion, stamped as unconverged (``<accept_unconverged>``;
+    :mod:`nmsm.core.unconverged`).
     """
 
     name: str
@@ -62,6 +66,7 @@ class StageSpec:
     enabled: bool
     file: Path
     line: int | None
+    accept_unconverged: bool = False
 
     def load_settings(self) -> StageSettings:
         """The stage's settings tree (a fresh copy; old schemas upgraded)."""
@@ -185,17 +190,28 @@ def _read_stage(element: etree._Element, path: Path, earlier_codes: list[str]) -
     if len(name) > MAX_NAME:
         raise InputError(f"stage name of {len(name)} characters ('{name[:20]}...') is too long for a folder name",
                          file=path, line=line, element="<Stage name>", expected=f"at most {MAX_NAME} characters")
-    enabled_text = _text(element.find("is_enabled"))
-    try:
-        enabled = to_bool(enabled_text) if enabled_text else True
-    except ValueError:
-        raise InputError(f"'{enabled_text}' is not a boolean", file=path, line=element.find("is_enabled").sourceline,
-                         element="<is_enabled>", expected="true or false") from None
+    enabled = _boolean(element, "is_enabled", path, default=True)
+    accept = _boolean(element, "accept_unconverged", path, default=False)
+    if accept and kind.tool_element not in SOLVING_TOOLS:
+        raise InputError(f"stage '{name}' ({kind.code}) solves no optimization", file=path,
+                         line=element.find("accept_unconverged").sourceline, element="<accept_unconverged>",
+                         expected="the element only in stages of JMP, MTP, NCP, GCP, TO, VO or DO")
     keep_element = element.find("keep_settings_inputs")
     keep = tuple(_text(keep_element).split())
     _check_keep(keep, kind, name, path, keep_element)
     return StageSpec(name=name, kind=kind, settings_file=settings_file, embedded=embedded, keep=keep,
-                     enabled=enabled, file=path, line=line)
+                     enabled=enabled, file=path, line=line, accept_unconverged=accept)
+
+
+def _boolean(stage: etree._Element, tag: str, path: Path, *, default: bool) -> bool:
+    """The stage's ``<tag>`` as a boolean (``default`` when missing or empty)."""
+    element = stage.find(tag)
+    text = _text(element)
+    try:
+        return to_bool(text) if text else default
+    except ValueError:
+        raise InputError(f"'{text}' is not a boolean", file=path, line=element.sourceline, element=f"<{tag}>",
+                         expected="true or false") from None
 
 
 def _check_keep(keep: tuple[str, ...], kind: StageKind, name: str, path: Path,

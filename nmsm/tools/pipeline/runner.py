@@ -179,14 +179,13 @@ def _check_stage_options(spec: PipelineSpec, stage_options: dict[str, dict[str, 
 
 def _with_accept_unconverged(spec: PipelineSpec, stage_options: dict[str, dict[str, Any]],
                              accept: bool) -> dict[str, dict[str, Any]]:
-    """``stage_options`` with ``accept_unconverged=True`` for every optimizing stage when ``accept``."""
+    """``stage_options`` with ``accept_unconverged=True`` for every optimizing stage when ``accept``
+    and for the stages whose ``<accept_unconverged>`` is true."""
     from nmsm.tools.dispatch import SOLVING_TOOLS
 
-    if not accept:
-        return stage_options
     out = {name: dict(options) for name, options in stage_options.items()}
     for stage in spec.stages:
-        if stage.kind.tool_element in SOLVING_TOOLS:
+        if stage.accept_unconverged or (accept and stage.kind.tool_element in SOLVING_TOOLS):
             out.setdefault(stage.name, {})["accept_unconverged"] = True
     return out
 
