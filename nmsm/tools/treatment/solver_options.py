@@ -34,7 +34,7 @@ MAX_TOLERANCE = 1e-2
 #: makes the objective at the guess orders of magnitude above its optimum, so
 #: :data:`MAX_TOLERANCE` of the normalized objective stops IPOPT before the optimum; TO and VO
 #: keep :data:`MAX_TOLERANCE`, where a tighter one gains little and costs iterations (the
-#: measurements: docs/treatment.md).
+#: measurements: docs/developing.md, "Treatment: measurements and audit trail").
 DESIGN_MAX_TOLERANCE = 1e-6
 
 

@@ -5,8 +5,8 @@ tracked-quantity RMS <= max(1.1 x the original's, 0.05 deg / 0.5 N·m); VO repro
 it starts from (<= 0.1 deg, <= 0.1 N·m) in far fewer iterations; a DO's objective within 10 %
 of the original's, or IPOPT restarted from the original's solution finds nothing better than
 ours (the original had not converged in our problem). ``benchmarks/bench_treatment.py`` prints
-the full table (docs/treatment.md). The toy arm and the torque TO V1 -> VO V1 chain run by
-default; the other tutorials are ``slow``.
+the full table (docs/developing.md, "Treatment: measurements and audit trail"). The toy arm and
+the torque TO V1 -> VO V1 chain run by default; the other tutorials are ``slow``.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from nmsm.tools.treatment.compare import Comparison, legacy_solution_folder, sco
 from nmsm.tools.treatment.run import TreatmentRun, run_settings
 
 #: known RMS exceedances at a lower total cost (a different trade-off between the terms), see
-#: docs/treatment.md; any other exceedance fails
+#: docs/developing.md (Treatment); any other exceedance fails
 KNOWN_RMS_EXCEEDANCES = {
     "SynergyTOSettingsV3": {"generalized_speed_tracking:ankle_angle_r"},
     "SynergyTOSettingsV4": {"generalized_speed_tracking:ankle_angle_r", "muscle_activation_tracking:gasmed_r",
