@@ -145,6 +145,9 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
 
 
 def ncp_xml(subject: Subject, folder: Path, n_synergies: int) -> str:
+    """The NCP stage: 5 synergies of 8 muscles leave the weights nearly free, and IPOPT takes
+    700-1300 iterations depending on the BLAS threads (a single-threaded batch worker takes the
+    most), hence ``max_iterations`` 3000."""
     terms = _term("moment_tracking", 1.0) + _term("activation_tracking", 0.02)
     return f"""<NeuralControlPersonalizationTool>
         <results_directory>ncp</results_directory>
@@ -156,6 +159,7 @@ def ncp_xml(subject: Subject, folder: Path, n_synergies: int) -> str:
         <normalized_fiber_length_muscle_groups/>
         <MuscleTendonLengthInitialization><is_enabled>false</is_enabled></MuscleTendonLengthInitialization>
         <mtp_results_directory>results/mtp</mtp_results_directory>
+        <max_iterations>3000</max_iterations>
         <RCNLCostTermSet>{terms}</RCNLCostTermSet>
         <RCNLSynergySet>
           <RCNLSynergy><muscle_group_name>{sm.SYNERGY_GROUP}</muscle_group_name><num_synergies>{n_synergies}</num_synergies></RCNLSynergy>
