@@ -79,7 +79,7 @@ def available_gigabytes() -> float:
     than what is left under an address-space limit (``ulimit -v``)."""
     available = float("inf")
     try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
+        for line in Path("/proc/meminfo").read_text(encoding="ascii").splitlines():
             if line.startswith("MemAvailable:"):
                 available = float(line.split()[1]) / 1e6
     except OSError:
@@ -87,7 +87,7 @@ def available_gigabytes() -> float:
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
         try:
-            used = float(Path("/proc/self/statm").read_text().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+            used = float(Path("/proc/self/statm").read_text(encoding="ascii").split()[0]) * os.sysconf("SC_PAGE_SIZE")
         except (OSError, ValueError):
             used = 0.0
         available = min(available, (soft - used) / 1e9)
