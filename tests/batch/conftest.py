@@ -22,6 +22,13 @@ def jmp_case(tmp_path_factory):
     return case
 
 
+@pytest.fixture(scope="module")
+def long_jmp_case(tmp_path_factory):
+    """A synthetic JMP case whose solve takes a few seconds: long enough for a test to kill
+    its worker before the run ends, however late the "started" event arrives."""
+    return make_synthetic_jmp_case(tmp_path_factory.mktemp("long_jmp_case"), duration=6.0)
+
+
 class BatchTimeout(Exception):
     pass
 

@@ -68,10 +68,10 @@ def test_runs_wait_for_their_dependencies_a_broken_file_fails_alone_and_a_rerun_
     assert all(r["objective"] for r in rows if r["status"] == "skipped")
 
 
-def test_a_worker_killed_mid_run_has_its_run_retried_and_the_batch_completes(jmp_case, tmp_path,
+def test_a_worker_killed_mid_run_has_its_run_retried_and_the_batch_completes(long_jmp_case, tmp_path,
                                                                             time_limit) -> None:
     time_limit(240)
-    batch = write_batch(tmp_path, sweep(jmp_case.settings_file))
+    batch = write_batch(tmp_path, sweep(long_jmp_case.settings_file))
     killed: list[tuple[str, int]] = []
     started: list[str] = []
 
