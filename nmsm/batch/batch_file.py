@@ -35,7 +35,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
-from nmsm.io.settings.document import ROOT, check_version, elements, parse_settings_xml
+from nmsm.io.settings.document import elements, read_tool_element
 from nmsm.io.xml_input import element_text
 
 TOOL = "BatchTool"
@@ -228,16 +228,7 @@ def _check_sweep(name: str, element: etree._Element, path: Path, parameters: tup
 def read_batch(path: str | os.PathLike[str], results_directory: str | os.PathLike[str] | None = None) -> BatchSpec:
     """Parse and check a batch file; ``results_directory`` replaces its ``<results_directory>``."""
     path = Path(path).resolve()
-    root = parse_settings_xml(path)
-    if root.tag != ROOT:
-        raise InputError(f"root element is <{root.tag}>", file=path, line=root.sourceline, element=f"<{root.tag}>",
-                         expected=f"<{ROOT}> with a <{TOOL}> element")
-    check_version(root, path)
-    tools = [c for c in elements(root) if c.tag == TOOL]
-    if len(tools) != 1:
-        raise InputError(f"{len(tools)} <{TOOL}> elements", file=path, line=root.sourceline,
-                         expected=f"exactly one <{TOOL}> (nmsm print-xml batch shows one)")
-    tool = tools[0]
+    tool = read_tool_element(path, TOOL, " (nmsm print-xml batch shows one)")
     for child in elements(tool):
         if child.tag not in ("results_directory", "RunList"):
             raise InputError(f"unknown element <{child.tag}> in <{TOOL}>", file=path, line=child.sourceline,

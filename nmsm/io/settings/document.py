@@ -465,3 +465,18 @@ OPENSIM_TOOL_FILES = {
     "ExternalLoads": "an ExternalLoads file is given to 'nmsm id' and 'nmsm preprocess' as --external-loads",
     "ScaleTool": "nmsm has no scaling tool: scale the model in OpenSim",
 }
+
+
+def read_tool_element(path: Path, tool: str, hint: str = "") -> etree._Element:
+    """The one ``<tool>`` element of the ``<NMSMPipelineDocument>`` file ``path`` (a pipeline or
+    batch file), its root and version checked; ``hint`` ends the error's expectation."""
+    root = parse_settings_xml(path)
+    if root.tag != ROOT:
+        raise InputError(f"root element is <{root.tag}>", file=path, line=root.sourceline, element=f"<{root.tag}>",
+                         expected=f"<{ROOT}> with a <{tool}> element")
+    check_version(root, path)
+    tools = [c for c in elements(root) if c.tag == tool]
+    if len(tools) != 1:
+        raise InputError(f"{len(tools)} <{tool}> elements", file=path, line=root.sourceline,
+                         expected=f"exactly one <{tool}>{hint}")
+    return tools[0]

@@ -31,7 +31,7 @@ from lxml import etree
 
 from nmsm.errors import InputError
 from nmsm.io.paths import resolve_path
-from nmsm.io.settings.document import ROOT, check_version, elements, parse_settings_xml, to_bool
+from nmsm.io.settings.document import ROOT, elements, parse_settings_xml, read_tool_element, to_bool
 from nmsm.tools.dispatch import SOLVING_TOOLS
 from nmsm.tools.pipeline.artifacts import INPUT_ELEMENTS
 from nmsm.tools.pipeline.kinds import StageKind, kind_for_element
@@ -108,16 +108,7 @@ def _text(element: etree._Element | None) -> str:
 def read_pipeline(path: str | os.PathLike[str]) -> PipelineSpec:
     """Parse and check a pipeline file (stage names, kinds, settings files exist)."""
     path = Path(path).resolve()
-    root = parse_settings_xml(path)
-    if root.tag != ROOT:
-        raise InputError(f"root element is <{root.tag}>", file=path, line=root.sourceline, element=f"<{root.tag}>",
-                         expected=f"<{ROOT}> with a <{TOOL}> element")
-    check_version(root, path)
-    tools = [c for c in elements(root) if c.tag == TOOL]
-    if len(tools) != 1:
-        raise InputError(f"{len(tools)} <{TOOL}> elements", file=path, line=root.sourceline,
-                         expected=f"exactly one <{TOOL}>")
-    tool = tools[0]
+    tool = read_tool_element(path, TOOL)
     results_text = _text(tool.find("results_directory"))
     if not results_text:
         raise InputError("no results folder", file=path, line=tool.sourceline, element="<results_directory>",
