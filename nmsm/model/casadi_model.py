@@ -255,6 +255,27 @@ class CasadiModel:
 
         return self._function(("velocity", body), build)
 
+    def body_points_function(self, body: str, locations: Any) -> cs.Function:
+        """``(q, qdot[, p]) -> (positions 3 x k, velocities 3 x k)`` (m, m/s, ground) of ``k``
+        points fixed in ``body``; ``locations`` (3, k) in the body frame (file geometry, m).
+
+        The body's pose and motion are computed once for all points, so the function grows
+        with ``k`` by a few operations a point (one :meth:`point_function` call per point
+        repeats the whole kinematic chain)."""
+        self._check_body(body)
+        local = np.asarray(locations, float).reshape(3, -1)
+
+        def build() -> cs.Function:
+            st = self.kinematics.forward(self.q, self.qdot)[body]
+            lever = cs.mtimes(st.R, cs.DM(local) * self.kinematics.scale(body))
+            n = local.shape[1]
+            positions = cs.repmat(st.p, 1, n) + lever
+            velocities = cs.repmat(st.v, 1, n) + cs.horzcat(*[cs.cross(st.w, lever[:, j]) for j in range(n)])
+            return cs.Function(function_name("points", body), self._inputs(self.q, self.qdot), [positions, velocities],
+                               self._input_names("q", "qdot"), ["positions", "velocities"])
+
+        return self._function(("points", body, local.tobytes()), build)
+
     def marker_velocity_function(self) -> cs.Function:
         """``(q, qdot[, p]) -> 3 x n_markers`` marker velocities (m/s, ground)."""
 

@@ -276,13 +276,20 @@ class ContactSurfaceModel:
         return args, names
 
     def _spring_kinematics(self, casadi_model: Any) -> tuple[Any, Any]:
-        q, qd = casadi_model.q, casadi_model.qdot
-        extra = [casadi_model.p] if casadi_model.has_parameters else []
-        positions, velocities = [], []
-        for body, location in zip(self.spring_bodies, self.spring_locations):
-            point = cs.DM(location)
-            positions.append(casadi_model.point_function(body)(q, point, *extra))
-            velocities.append(casadi_model.point_velocity_function(body)(q, qd, point, *extra))
+        args, _ = self._inputs(casadi_model)
+        return self.spring_kinematics(casadi_model, *args)
+
+    def spring_kinematics(self, casadi_model: Any, q: Any, qdot: Any, *parameters: Any) -> tuple[Any, Any]:
+        """``(positions 3 x n, velocities 3 x n)`` (m, m/s, ground) of the springs at ``q``,
+        ``qdot`` (and the model's parameters, if it has any), in spring order; each body's
+        motion is computed once for its springs."""
+        bodies = self.spring_bodies
+        positions, velocities = [None] * len(bodies), [None] * len(bodies)
+        for body in dict.fromkeys(bodies):
+            index = [j for j, b in enumerate(bodies) if b == body]
+            x, v = casadi_model.body_points_function(body, self.spring_locations[index].T)(q, qdot, *parameters)
+            for k, j in enumerate(index):
+                positions[j], velocities[j] = x[:, k], v[:, k]
         return cs.horzcat(*positions), cs.horzcat(*velocities)
 
     def spring_kinematics_function(self, casadi_model: Any) -> cs.Function:

@@ -19,7 +19,7 @@ import numpy as np
 from nmsm.core.function_names import function_name
 from nmsm.core.plugin_bases import ContactModel
 from nmsm.errors import InputError, ModelError
-from nmsm.model.foot_contact import CONTACT_PARAMETERS, ContactSurfaceModel, contact_function, spring_forces
+from nmsm.model.foot_contact import CONTACT_PARAMETERS, ContactSurfaceModel, contact_function
 
 
 class ElasticFoundationContact(ContactModel):
@@ -82,17 +82,11 @@ class ElasticFoundationContact(ContactModel):
         q, qd = cs.SX.sym("q", cm.n), cs.SX.sym("qd", cm.n)
         p = cs.SX.sym("p", len(CONTACT_PARAMETERS))
         geometry = [cm.p] if cm.has_parameters else []  # the model's parameters, when it has any
-        positions, velocities = [], []
-        for body, location in zip(surface.spring_bodies, surface.spring_locations):
-            point = cs.DM(location)
-            positions.append(cm.point_function(body)(q, point, *geometry))
-            velocities.append(cm.point_velocity_function(body)(q, qd, point, *geometry))
-        positions, velocities = cs.horzcat(*positions), cs.horzcat(*velocities)
+        positions, velocities = surface.spring_kinematics(cm, q, qd, *geometry)
         marker = cm.marker_function([surface.midfoot_superior_marker])(q, *geometry)
         reference = cs.vertcat(marker[0], 0, marker[2])
-        force, moment, _ = contact_function(surface.n_springs)(positions, velocities, cs.DM(surface.spring_constants),
-                                                               p, reference)
-        forces = spring_forces(positions, velocities, cs.DM(surface.spring_constants), p)
+        force, moment, forces = contact_function(surface.n_springs)(positions, velocities,
+                                                                    cs.DM(surface.spring_constants), p, reference)
         columns = []
         for body in surface.bodies:
             _, origin = cm.body_pose_function(body)(q, *geometry)

@@ -229,7 +229,8 @@ class ContextQuantities:
                 (tau,) = self.map_point(f, grid, *self.model_parameter_row())
                 return tau
             f = self.composed("inverse_dynamics_contact", self._contact_inverse_dynamics_function())
-            (tau,) = self.map_point(f, grid, *[c.parameters() for c in contacts], *self.model_parameter_row())
+            loads = [self.contact_outputs(grid, c)[0] for c in contacts]
+            (tau,) = self.map_point(f, grid, *loads, *self.model_parameter_row())
             return tau
         return self.cache((grid, "inverse_dynamics"), compute)
 
@@ -238,37 +239,42 @@ class ContextQuantities:
         return self.cache(("contact_function", id(contact)), lambda: contact.point_function(self.data.model))
 
     def _contact_inverse_dynamics_function(self) -> cs.Function:
-        """SX ``(q, qd, qdd, p_1, ..., p_m) -> tau`` with every contact model's loads."""
+        """SX ``(q, qd, qdd, l_1, ..., l_m, *geometry) -> tau``; ``l_i`` (9 k_i) are contact
+        model ``i``'s loads on its ``k_i`` bodies, each (force N, point m, torque N·m) in ground."""
         def compute() -> cs.Function:
             model = self.data.model
             contacts = self.data.contact_models
             bodies = tuple(b for c in contacts for b in c.load_bodies)
             nq = len(model.coordinate_names)
             q, qd, qdd = (cs.SX.sym(n, nq) for n in ("q", "qd", "qdd"))
-            params, loads = [], []
-            for c in contacts:
-                f = self.contact_function(c)
-                p = cs.SX.sym("p", f.size1_in(2))
-                params.append(p)
-                loads.append(f(q, qd, p)[0])
+            columns = [cs.SX.sym(f"loads_{c.name}", 9 * len(c.load_bodies)) for c in contacts]
+            loads = cs.horzcat(*[cs.reshape(col, 9, len(c.load_bodies)) for col, c in zip(columns, contacts)])
             geometry = self.model_parameter_symbols()
-            tau = model.inverse_dynamics_function(bodies)(q, qd, qdd, cs.horzcat(*loads), *geometry)
-            return cs.Function("inverse_dynamics_contact", [q, qd, qdd, *params, *geometry], [tau])
+            tau = model.inverse_dynamics_function(bodies)(q, qd, qdd, loads, *geometry)
+            return cs.Function("inverse_dynamics_contact", [q, qd, qdd, *columns, *geometry], [tau])
         return self.cache(("contact_inverse_dynamics_function",), compute)
 
-    def ground_reaction(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
-        """(force, moment about the point, point), each (n, 3), ground, of one contact model."""
-        def compute() -> tuple[cs.MX, cs.MX, cs.MX]:
+    def contact_outputs(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX, cs.MX]:
+        """One contact model evaluated once on every row of ``grid``: ``(loads (n, 9 k) on its
+        k load bodies, each (force N, point m, torque N·m), force (n, 3) N, moment about its
+        reference point (n, 3) N·m, reference point (n, 3) m)``, all in ground. The inverse
+        dynamics and the ground reaction terms share this one evaluation."""
+        def compute() -> tuple[cs.MX, cs.MX, cs.MX, cs.MX]:
             f = self.contact_function(contact)
             nq = len(self.data.model.coordinate_names)
             q, qd = cs.SX.sym("q", nq), cs.SX.sym("qd", nq)
             p = cs.SX.sym("p", f.size1_in(2))
-            _, force, moment, point = f(q, qd, p)
-            g = cs.Function(function_name("ground_reaction", contact.name), [q, qd, p], [force, moment, point])
-            composed = self.composed(("ground_reaction", id(contact)), g, "q, qd")
-            force, moment, point = self.map_point(composed, grid, contact.parameters())
-            return force, moment, point
-        return self.cache((grid, "ground_reaction", id(contact)), compute)
+            loads, force, moment, point = f(q, qd, p)
+            g = cs.Function(function_name("contact_outputs", contact.name), [q, qd, p],
+                            [cs.reshape(loads, -1, 1), force, moment, point])
+            composed = self.composed(("contact_outputs", id(contact)), g, "q, qd")
+            loads, force, moment, point = self.map_point(composed, grid, contact.parameters())
+            return loads, force, moment, point
+        return self.cache((grid, "contact_outputs", id(contact)), compute)
+
+    def ground_reaction(self, grid: str, contact: Any) -> tuple[cs.MX, cs.MX, cs.MX]:
+        """(force, moment about the point, point), each (n, 3), ground, of one contact model."""
+        return self.contact_outputs(grid, contact)[1:]
 
     def find_reaction(self, label: str) -> tuple[Any, str, int]:
         """(contact model, 'force'|'moment'|'point', axis index) of a ground reaction column."""
