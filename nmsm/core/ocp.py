@@ -74,6 +74,15 @@ def _ranges(instance: Any, attribute: attrs.Attribute, value: tuple[float, ...] 
                                  field=attribute.name, expected=expected)
 
 
+class DiscontinuousDerivativeWarning(UserWarning):
+    """A term differentiates (``ctx.differentiate``) a quantity that depends on the controls
+    (accelerations, torque controls, activations): values at the collocation points free to
+    jump from one mesh interval to the next. The derivative is taken inside each interval and
+    does not see those jumps, so minimising or bounding it can leave (or create) large jumps
+    while the solver reports success. Differentiate states (coordinates, speeds) instead, or
+    accept the derivative knowing this. Issued once per term (type, settings file and line)."""
+
+
 class OcpTerm(Protocol):
     """What every optimal-control term declares to the tool."""
 
@@ -312,10 +321,12 @@ class OcpContext(OcpGrid, Protocol):
         interval's polynomial on its collocation points.
 
         Safe to minimise only for quantities continuous across mesh intervals: the states
-        (coordinates and speeds of ``<states_coordinate_list>``). Quantities known only at
-        the collocation points - accelerations, controls - may jump from one interval to the
-        next, which this derivative does not see: minimising it can raise the true derivative
-        while the solver reports success.
+        (coordinates and speeds of ``<states_coordinate_list>``) and what depends on them
+        only (marker positions, orientations). Quantities that depend on the controls -
+        accelerations, inverse-dynamics loads, torque controls, activations - may jump from
+        one interval to the next, which this derivative does not see: minimising it can raise
+        the true derivative while the solver reports success. Such a term gets a
+        :class:`DiscontinuousDerivativeWarning` when it is built (once per term).
         """
 
     # ---- name checks (raise InputError naming the term's settings file and line) ----
@@ -356,6 +367,6 @@ def evaluation_of(term: Any) -> Evaluation:
     return evaluation
 
 
-__all__ = ["ContinuousCost", "DiscreteCost", "Evaluation", "OCP_BASES", "ON_COLLOCATION_POINTS", "OcpContext",
+__all__ = ["ContinuousCost", "DiscontinuousDerivativeWarning", "DiscreteCost", "Evaluation", "OCP_BASES", "ON_COLLOCATION_POINTS", "OcpContext",
            "OcpGrid", "OcpTerm", "PathConstraint", "TREATMENT_TOOLS", "TerminalConstraint", "evaluation_of",
            "require_axis"]

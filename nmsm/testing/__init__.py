@@ -6,46 +6,60 @@ In the manner of scikit-learn's ``check_estimator``::
     from my_plugin.terms import CoordinateLimitPenalty
 
     def test_conforms():
-        check_term(CoordinateLimitPenalty, {"coordinate": "q0", "upper_limit": "0.2"})
+        report = check_term(CoordinateLimitPenalty, {"coordinate": "q0", "upper_limit": "0.2"})
+        assert report.not_built is None and not report.warnings
 
 :func:`check_term` raises :class:`TermCheckError` saying what is wrong, and returns a
 :class:`TermCheckReport` of what it checked. ``nmsm plugins --check`` runs it on every
 registered term and constraint.
 
-Checks, for every term:
+Checks, for every term (the names in ``report.passed``):
 
-* the class is usable from settings XML (decorated, ``type``, ``tools``, field types), has a
-  docstring, and a Treatment Optimization term declares its ``evaluation`` (it subclasses a
-  base of :mod:`nmsm.core.ocp`);
-* the example settings elements build at least one term (``from_spec``);
-* bad elements are refused with an :class:`~nmsm.errors.InputError`: an unknown element
-  (unless the term has an ``options`` field, which keeps them), ``max_allowable_error`` 0
-  (costs), ``min_error`` above ``max_error`` (constraints).
+``declaration``            the class is usable from settings XML (decorated, ``type``, ``tools``,
+                           field types), has a docstring, and a Treatment Optimization term
+                           declares its ``evaluation`` (it subclasses a base of :mod:`nmsm.core.ocp`);
+``settings``               the example settings elements build at least one term (``from_spec``);
+``bad elements refused``   an :class:`~nmsm.errors.InputError` naming the element for an unknown
+                           element (unless the term has an ``options`` field, which keeps them),
+                           ``max_allowable_error`` 0 (costs), ``min_error`` above ``max_error``
+                           (constraints).
 
-For Treatment Optimization terms (TO, VO, DO), on a small synthetic problem (a two-link
-pendulum with a coupled coordinate; coordinates ``q0``, ``q1``, ``follower``, markers
-``tip_0``, ``tip_1``, ``follower_marker``, bodies ``link_0``, ``link_1``, torque controls
-``q0_moment``, ``q1_moment``; states at the tracked motion):
+Then, on a small synthetic problem of the tool (built in code, no files of the user's):
 
-* the term binds and builds (its quantity has the shape its evaluation requires);
-* its residuals are finite, and their exact (CasADi) derivative along a random direction
-  matches central finite differences;
-* a ``*_tracking`` term of the kinematics is zero where the motion is the tracked one.
+``shape``                  the term builds on the tool's problem through the tool's own context
+                           and reduction (a treatment quantity has the shape its evaluation needs;
+                           a GCP quantity has one block per foot), has at least one residual, and
+                           depends on the design variables;
+``built, finite``          its residuals are finite near the starting point;
+``derivatives``            their exact (CasADi) derivative along a random direction matches
+                           central finite differences;
+``zero at perfect tracking``  a tracking term is zero where the synthetic data are reproduced
+                           exactly (built-in tracking terms; ``zero_at_tracking=True`` for yours);
+``unknown names refused``  a name element (``<coordinate>``, ``<marker>``, ...) naming what the
+                           problem has not is refused with an InputError quoting the name.
 
-A term that needs what the pendulum has not (muscles, contact, synergies, a metabolic model)
-is reported as not built (``report.not_built`` names why); its declaration and settings
-checks still run.
+The synthetic problems: Treatment Optimization (TO, VO, DO): a two-link pendulum with a coupled
+coordinate; coordinates ``q0``, ``q1``, ``follower``, markers ``tip_0``, ``tip_1``,
+``follower_marker``, bodies ``link_0``, ``link_1``, torque controls ``q0_moment``,
+``q1_moment``; states at the tracked motion (:mod:`nmsm.testing.pendulum_problem`). MTP, SynX,
+MTLI, NCP, GCP, JMP: :mod:`nmsm.testing.synthetic_problems` (muscles, synergy groups, a foot,
+a leg). A treatment term that needs what the pendulum has not (muscles, contact, synergies, a
+metabolic model) is reported as not built (``report.not_built`` says why); its declaration
+and settings checks still run. A treatment term that differentiates a quantity depending on
+the controls gets a :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning`, recorded in
+``report.warnings``.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
 import attrs
 import numpy as np
 
-from nmsm.core.ocp import TREATMENT_TOOLS
+from nmsm.core.ocp import TREATMENT_TOOLS, DiscontinuousDerivativeWarning
 from nmsm.core.term import (
     LIST_TO_SINGULAR,
     ConstraintTerm,
@@ -56,6 +70,7 @@ from nmsm.core.term import (
     term_class_problems,
 )
 from nmsm.errors import InputError, NmsmError
+from nmsm.testing.synthetic_problems import BUILDERS, ZERO_AT_TRACKED, SyntheticProblem
 
 #: Values of required fields on the synthetic pendulum, used when the example does not give them.
 PENDULUM_VALUES: dict[str, str] = {
@@ -63,7 +78,7 @@ PENDULUM_VALUES: dict[str, str] = {
     "load": "q0_moment",
     "marker": "tip_1",
     "body": "link_1",
-    "axis": "x",
+    "axis": "x",  # markers (orientations and angular momentum: "z")
     "controller": "q0_moment",
 }
 
@@ -79,9 +94,13 @@ PLACEHOLDER_VALUES: dict[str, str] = {
     "function_name": "check_term_no_such_function",
 }
 
-#: Families whose ``*_tracking`` cost is zero on the tracked motion.
+#: Families whose ``*_tracking`` treatment cost is zero on the tracked motion.
 _ZERO_AT_TRACKING = ("generalized_coordinate", "generalized_speed", "marker_position", "marker_velocity",
                      "body_orientation")
+
+#: Fields naming a part of the model or data; :func:`check_term` sets each to a name the
+#: synthetic problem has not and expects an InputError quoting it.
+NAME_FIELDS = ("coordinate", "load", "marker", "body", "controller", "muscle", "hindfoot_body", "synergy")
 
 
 class TermCheckError(AssertionError):
@@ -90,15 +109,18 @@ class TermCheckError(AssertionError):
 
 @attrs.define
 class TermCheckReport:
-    """What :func:`check_term` checked: ``passed`` (names of checks) and ``not_built`` (why
-    the term was not built on the synthetic problem, or None)."""
+    """What :func:`check_term` checked: ``passed`` (names of checks), ``not_built`` (why the
+    term was not built on the synthetic problem, or None) and ``warnings`` (messages of
+    :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning` while building)."""
 
     cls: type
     passed: list[str] = attrs.field(factory=list)
     not_built: str | None = None
+    warnings: list[str] = attrs.field(factory=list)
 
 
-def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str | None = None) -> TermCheckReport:
+def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str | None = None,
+               zero_at_tracking: bool | None = None) -> TermCheckReport:
     """Run the conformance checks of the module docstring on term class ``cls``.
 
     ``example``: settings elements -> text for the term's fields (what its ``<RCNLCostTerm>``
@@ -106,14 +128,17 @@ def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str
     fields missing from it take :data:`PENDULUM_VALUES` (and required ones
     :data:`PLACEHOLDER_VALUES`). A required field still without a value stops the checks
     after the declaration (``report.not_built`` says which). ``tool``: the tool to check for
-    (default: a treatment tool the class accepts, else its first tool).
+    (default: a treatment tool the class accepts, else its first tool with a synthetic
+    problem). ``zero_at_tracking``: demand (True) or skip (False) the tracking check; None:
+    for the built-in tracking terms.
     """
     report = TermCheckReport(cls)
     name = f"{getattr(cls, '__module__', '?')}.{getattr(cls, '__qualname__', cls)}"
     if not (isinstance(cls, type) and issubclass(cls, (CostTerm, ConstraintTerm))):
         raise TermCheckError(f"{name} is not a subclass of nmsm.core.term.CostTerm or ConstraintTerm")
     _check_declaration(cls, name, report)
-    tool = tool or (sorted(cls.tools & TREATMENT_TOOLS) or sorted(cls.tools))[0]
+    tool = tool or (sorted(cls.tools & TREATMENT_TOOLS) or sorted(cls.tools & set(BUILDERS))
+                    or sorted(cls.tools))[0]
     elements = _example_elements(cls, example)
     missing = cls._missing_required({cls.aliases.get(e, e) for e in elements}
                                     | {s for p, s in LIST_TO_SINGULAR.items() if p in elements})
@@ -122,10 +147,18 @@ def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str
                             f"check_example on the class or pass check_term(cls, example={{...}})")
         return report
     terms = _check_settings(cls, name, elements, report)
-    if tool in TREATMENT_TOOLS:
-        _check_on_pendulum(cls, name, terms[0], tool, report)
-    else:
+    if tool not in TREATMENT_TOOLS and tool not in BUILDERS:
         report.not_built = f"no synthetic problem for {tool} (declaration and settings checked)"
+        return report
+    built = _build(name, terms[0], tool, report)
+    if built is None:
+        return report
+    if zero_at_tracking is None:
+        family = cls.type[: -len("_tracking")] if cls.type.endswith("_tracking") else None
+        zero_at_tracking = (family in _ZERO_AT_TRACKING if tool in TREATMENT_TOOLS
+                            else (tool, cls.type) in ZERO_AT_TRACKED)
+    _check_numbers(name, cls, terms[0], tool, built, zero_at_tracking, report)
+    _check_bad_names(name, cls, tool, elements, report)
     return report
 
 
@@ -154,6 +187,8 @@ def _example_elements(cls: type, example: Mapping[str, str] | None) -> dict[str,
     for field, text in PENDULUM_VALUES.items():
         if field in fields and field not in given:
             elements[field] = text
+    if "axis" in fields and "axis" not in given and "marker" not in fields:
+        elements["axis"] = "z"  # the pendulum turns about z: orientations and angular momentum vary there only
     for field in cls._missing_required(given | set(elements)):
         if field in PLACEHOLDER_VALUES:
             elements[field] = PLACEHOLDER_VALUES[field]
@@ -184,7 +219,10 @@ def _check_settings(cls: type, name: str, elements: dict[str, str], report: Term
     for wrong in wrongs:
         try:
             cls.from_spec(_spec(cls, {**elements, **wrong}))
-        except InputError:
+        except InputError as exc:
+            if not any(element in str(exc) for element in wrong):
+                raise TermCheckError(f"{name}: the settings elements {wrong} were refused, but the message names "
+                                     f"none of them: {exc}") from exc
             continue
         raise TermCheckError(f"{name}: the settings elements {wrong} were accepted "
                              "(expected an InputError naming them)")
@@ -192,38 +230,80 @@ def _check_settings(cls: type, name: str, elements: dict[str, str], report: Term
     return terms
 
 
-def _check_on_pendulum(cls: type, name: str, term: Term, tool: str, report: TermCheckReport) -> None:
-    import casadi as cs
-
+def _pendulum_problem(term: Term, tool: str) -> SyntheticProblem:
+    """The pendulum problem with ``term`` added; tracked point: the states on the tracked motion."""
     from nmsm.testing.pendulum_problem import build_pendulum_problem
 
     built = build_pendulum_problem([], tool=tool)
     problem, ctx = built.problem, built.context
-    try:
-        term.bind(ctx)
-    except InputError as exc:  # the term needs what the pendulum has not (bind said so)
-        report.not_built = str(exc)
-        return
-    try:
-        problem.add_term(term, ctx)
-    except NmsmError as exc:  # bound, but its quantity does not build (shape, a missing quantity, ...)
-        raise TermCheckError(f"{name}: building on the synthetic problem failed: {exc}") from exc
+    term.bind(ctx)
+    problem.add_term(term, ctx)
+    lower, upper = problem.bounds_scaled()
+    return SyntheticProblem(problem, ctx, np.clip(problem.initial_scaled(), lower, upper))
+
+
+def _build(name: str, term: Term, tool: str, report: TermCheckReport) -> SyntheticProblem | None:
+    """The term on its tool's synthetic problem; None (``report.not_built`` says why) when the
+    term needs what the problem has not (an InputError from binding)."""
+    builder = _pendulum_problem if tool in TREATMENT_TOOLS else BUILDERS[tool]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DiscontinuousDerivativeWarning)
+        try:
+            built = builder(term, tool)
+        except InputError as exc:  # the term needs what the synthetic problem has not (bind said so)
+            report.not_built = str(exc)
+            return None
+        except NmsmError as exc:  # bound, but its quantity does not build (shape, a missing quantity, ...)
+            raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: {exc}") from exc
+        except Exception as exc:  # the tool's reduction refused the quantity's form
+            raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: "
+                                 f"{type(exc).__name__}: {exc}") from exc
+    for warning in caught:
+        if issubclass(warning.category, DiscontinuousDerivativeWarning):
+            report.warnings.append(str(warning.message))
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+    return built
+
+
+def _expression(name: str, cls: type, term: Term, built: SyntheticProblem) -> Any:
+    import casadi as cs
+
+    problem = built.problem
     entries = [e for e in (problem.costs if cls.kind == "cost" else problem.constraints) if e.term is term]
     if not entries:
         raise TermCheckError(f"{name}: the built problem has no entry of the term")
-    expression = cs.vertcat(*[e.residuals if cls.kind == "cost" else e.expression for e in entries])
+    return cs.vertcat(*[e.residuals if cls.kind == "cost" else e.expression for e in entries])
+
+
+def _check_numbers(name: str, cls: type, term: Term, tool: str, built: SyntheticProblem,
+                   zero_at_tracking: bool, report: TermCheckReport) -> None:
+    """Shape, finite values, dependence on the variables, exact vs finite-difference
+    derivatives, zero on the tracked point (module docstring)."""
+    import casadi as cs
+
+    problem = built.problem
+    expression = _expression(name, cls, term, built)
+    if expression.numel() == 0:
+        raise TermCheckError(f"{name}: no residual on the synthetic {tool} problem (an empty quantity)")
+    if built.shape_problem:
+        raise TermCheckError(f"{name}: on the synthetic {tool} problem the {built.shape_problem}")
     x = problem.scaled_vector()
     p = problem.parameter_vector()
+    if not cs.depends_on(expression, x):
+        raise TermCheckError(f"{name}: its value does not depend on any design variable of the synthetic {tool} "
+                             "problem (a constant cannot be optimized: does it read data instead of the model?)")
+    report.passed.append("shape")
     lower, upper = problem.bounds_scaled()
-    tracked = np.clip(problem.initial_scaled(), lower, upper)  # states on the tracked motion
+    start = np.clip(problem.initial_scaled() if built.tracked is None else built.tracked, lower, upper)
     rng = np.random.default_rng(0)
-    x0 = np.clip(tracked + 0.05 * rng.standard_normal(tracked.size), lower, upper)
+    x0 = np.clip(start + 0.05 * rng.standard_normal(start.size), lower, upper)
     values = problem.parameter_values()
     f = cs.Function("f", [x, p], [expression])
     jac = cs.Function("j", [x, p], [cs.jacobian(expression, x)])
     value = np.asarray(f(x0, values)).ravel()
     if not np.all(np.isfinite(value)):
-        raise TermCheckError(f"{name}: non-finite values on the synthetic problem")
+        raise TermCheckError(f"{name}: non-finite values on the synthetic {tool} problem")
     report.passed.append("built, finite")
     direction = rng.standard_normal(x0.size)
     direction /= np.linalg.norm(direction)
@@ -238,13 +318,39 @@ def _check_on_pendulum(cls: type, name: str, term: Term, tool: str, report: Term
         raise TermCheckError(f"{name}: exact derivative {ad[worst]:.6g} differs from finite differences "
                              f"{fd[worst]:.6g} (row {worst})")
     report.passed.append("derivatives")
-    family = cls.type[: -len("_tracking")] if cls.type.endswith("_tracking") else None
-    if family in _ZERO_AT_TRACKING:
-        at_tracked = np.asarray(f(tracked, values)).ravel()
+    if zero_at_tracking:
+        if built.tracked is None:
+            raise TermCheckError(f"{name}: zero_at_tracking asked, but the synthetic {tool} problem has no point "
+                                 "where its data are tracked exactly")
+        at_tracked = np.asarray(f(built.tracked, values)).ravel()
         if np.max(np.abs(at_tracked), initial=0.0) > 1e-6:
             raise TermCheckError(f"{name}: not zero on the tracked motion (max |residual| "
                                  f"{np.max(np.abs(at_tracked)):.3g})")
         report.passed.append("zero at perfect tracking")
 
 
-__all__ = ["PENDULUM_VALUES", "PLACEHOLDER_VALUES", "TermCheckError", "TermCheckReport", "check_term"]
+def _check_bad_names(name: str, cls: type, tool: str, elements: dict[str, str], report: TermCheckReport) -> None:
+    """Each name element the term has (``<coordinate>``, ``<marker>``, ...) set to a name the
+    synthetic problem lacks: building must raise an InputError quoting the name."""
+    fields = cls.xml_fields()
+    checked = False
+    for field in NAME_FIELDS:
+        if field not in fields or fields[field] is not str:
+            continue
+        wrong = f"check_term_no_such_{field}"
+        term = cls.from_spec(_spec(cls, {**{k: v for k, v in elements.items()
+                                            if cls.aliases.get(k, k) != field
+                                            and LIST_TO_SINGULAR.get(k) != field}, field: wrong}))[0]
+        outcome = TermCheckReport(cls)
+        if _build(name, term, tool, outcome) is not None:
+            raise TermCheckError(f"{name}: <{field}> '{wrong}' (a name the synthetic problem has not) was accepted "
+                                 "(expected an InputError naming it, raised from bind with ctx.require_...)")
+        if wrong not in (outcome.not_built or ""):
+            raise TermCheckError(f"{name}: <{field}> '{wrong}' was refused, but the message does not name it: "
+                                 f"{outcome.not_built}")
+        checked = True
+    if checked:
+        report.passed.append("unknown names refused")
+
+
+__all__ = ["NAME_FIELDS", "PENDULUM_VALUES", "PLACEHOLDER_VALUES", "TermCheckError", "TermCheckReport", "check_term"]

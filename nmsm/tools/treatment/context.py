@@ -53,6 +53,7 @@ settings file and line): ``require_coordinate``, ``require_state_coordinate``,
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -60,7 +61,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core import reductions
-from nmsm.core.ocp import evaluation_of
+from nmsm.core.ocp import DiscontinuousDerivativeWarning, evaluation_of
 from nmsm.tools.treatment.orientation import check_sequence
 from nmsm.tools.treatment.transcription.base import map_rows
 
@@ -476,8 +477,15 @@ class TreatmentContext(GridView):
 
     def differentiate(self, values: Any) -> cs.MX:
         """Time derivative (per second) of (K, m) collocation values through each interval's
-        interpolating polynomial on its collocation points (an interval with one point: 0)."""
-        return self._q.collocation_derivative() @ cs.MX(values) / self.final_time
+        interpolating polynomial on its collocation points (an interval with one point: 0).
+
+        Values that depend on the controls may jump between intervals, which this derivative
+        does not see: the term being built then gets a
+        :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning` (when it is reduced)."""
+        values = cs.MX(values)
+        if self._q.depends_on_controls(values):
+            self._q.jump_derivative_pending = True
+        return self._q.collocation_derivative() @ values / self.final_time
 
     def synergy_vector(self, name: str, *, initial: bool = False) -> Any:
         """(1, M_g) synergy vector of ``<group>_<k>`` (MX; numpy when ``initial``)."""
@@ -501,7 +509,26 @@ class TreatmentContext(GridView):
             mask |= (s >= a - 1e-12) & (s <= b + 1e-12)
         return mask
 
+    def _warn_jump_derivative(self, term: Any) -> None:
+        """Warn once per term that differentiated a quantity depending on the controls."""
+        if not self._q.jump_derivative_pending:
+            return
+        self._q.jump_derivative_pending = False
+        key = (term.type, term.source.file, term.source.line)
+        if key in self._q.jump_derivative_warned:
+            return
+        self._q.jump_derivative_warned.add(key)
+        where = f"{term.source.file}:{term.source.line}: " if term.source.file else ""
+        warnings.warn(
+            f"{where}term '{term.type}' ({type(term).__qualname__}) differentiates a quantity that depends on the "
+            "controls (accelerations, loads, torque controls or activations), which may jump from one mesh "
+            "interval to the next: ctx.differentiate does not see those jumps, so minimising or bounding this "
+            "derivative can raise the true one while the solver reports success. Differentiate a state "
+            "(coordinate or speed) instead, or see docs/plugins.md 'Derivatives of the context'",
+            DiscontinuousDerivativeWarning, stacklevel=2)
+
     def reduce_cost(self, term: CostTerm, normalized: Any) -> Any:
+        self._warn_jump_derivative(term)
         if evaluation_of(term) == "discrete":
             z = cs.MX(normalized)
             if z.numel() != 1:
@@ -517,6 +544,7 @@ class TreatmentContext(GridView):
         return residuals
 
     def reduce_constraint(self, term: ConstraintTerm, value: Any) -> tuple[Any, Any, Any]:
+        self._warn_jump_derivative(term)
         v = cs.MX(value)
         if evaluation_of(term) == "terminal":
             if v.numel() != 1:

@@ -45,6 +45,17 @@ class ContextQuantities:
         for controller in data.controllers:
             names.extend(m for m in controller.muscle_names() if m not in names)
         self.muscle_names = tuple(names)
+        #: set by ``differentiate`` of a quantity depending on the controls, cleared when the
+        #: term is reduced (which warns naming it; see GridView._warn_jump_derivative)
+        self.jump_derivative_pending = False
+        self.jump_derivative_warned: set[tuple[Any, ...]] = set()
+
+    def depends_on_controls(self, values: Any) -> bool:
+        """True if ``values`` (MX) depend on the control variables (the per-collocation-point
+        accelerations and controller controls, free to jump between mesh intervals)."""
+        name = getattr(self.trajectory, "control_var", "")
+        variable = self.trajectory.problem.variables.get(name) if name else None
+        return variable is not None and bool(cs.depends_on(cs.MX(values), variable.scaled_symbol))
 
     def cache(self, key: Any, compute: Callable[[], Any]) -> Any:
         if key not in self._cache:
