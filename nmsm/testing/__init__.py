@@ -230,34 +230,39 @@ def _check_settings(cls: type, name: str, elements: dict[str, str], report: Term
     return terms
 
 
-def _pendulum_problem(term: Term, tool: str) -> SyntheticProblem:
-    """The pendulum problem with ``term`` added; tracked point: the states on the tracked motion."""
+def _pendulum_problem(tool: str) -> SyntheticProblem:
+    """The pendulum problem; tracked point: the states on the tracked motion."""
     from nmsm.testing.pendulum_problem import build_pendulum_problem
 
     built = build_pendulum_problem([], tool=tool)
-    problem, ctx = built.problem, built.context
-    term.bind(ctx)
-    problem.add_term(term, ctx)
-    lower, upper = problem.bounds_scaled()
-    return SyntheticProblem(problem, ctx, np.clip(problem.initial_scaled(), lower, upper))
+    lower, upper = built.problem.bounds_scaled()
+    return SyntheticProblem(built.problem, built.context, np.clip(built.problem.initial_scaled(), lower, upper))
 
 
 def _build(name: str, term: Term, tool: str, report: TermCheckReport) -> SyntheticProblem | None:
-    """The term on its tool's synthetic problem; None (``report.not_built`` says why) when the
-    term needs what the problem has not (an InputError from binding)."""
-    builder = _pendulum_problem if tool in TREATMENT_TOOLS else BUILDERS[tool]
+    """The tool's synthetic problem with the term added; None (``report.not_built`` says why)
+    when binding the term raised an InputError (it needs what the problem has not)."""
+    built = _pendulum_problem(tool) if tool in TREATMENT_TOOLS else BUILDERS[tool](tool)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", DiscontinuousDerivativeWarning)
         try:
-            built = builder(term, tool)
+            term.bind(built.context)
         except InputError as exc:  # the term needs what the synthetic problem has not (bind said so)
             report.not_built = str(exc)
             return None
+        except NmsmError as exc:
+            raise TermCheckError(f"{name}: bind failed on the synthetic {tool} problem: {exc}") from exc
+        try:
+            form = built.form_problem(term) if built.form_problem is not None else None
+            if form is None:
+                built.add_term(term)
         except NmsmError as exc:  # bound, but its quantity does not build (shape, a missing quantity, ...)
             raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: {exc}") from exc
         except Exception as exc:  # the tool's reduction refused the quantity's form
             raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: "
                                  f"{type(exc).__name__}: {exc}") from exc
+    if form is not None:
+        raise TermCheckError(f"{name}: on the synthetic {tool} problem the {form}")
     for warning in caught:
         if issubclass(warning.category, DiscontinuousDerivativeWarning):
             report.warnings.append(str(warning.message))
@@ -286,8 +291,6 @@ def _check_numbers(name: str, cls: type, term: Term, tool: str, built: Synthetic
     expression = _expression(name, cls, term, built)
     if expression.numel() == 0:
         raise TermCheckError(f"{name}: no residual on the synthetic {tool} problem (an empty quantity)")
-    if built.shape_problem:
-        raise TermCheckError(f"{name}: on the synthetic {tool} problem the {built.shape_problem}")
     x = problem.scaled_vector()
     p = problem.parameter_vector()
     if not cs.depends_on(expression, x):
@@ -342,7 +345,12 @@ def _check_bad_names(name: str, cls: type, tool: str, elements: dict[str, str], 
                                             if cls.aliases.get(k, k) != field
                                             and LIST_TO_SINGULAR.get(k) != field}, field: wrong}))[0]
         outcome = TermCheckReport(cls)
-        if _build(name, term, tool, outcome) is not None:
+        try:
+            built = _build(name, term, tool, outcome)
+        except TermCheckError as exc:
+            raise TermCheckError(f"{name}: <{field}> '{wrong}' (a name the synthetic problem has not) was not refused "
+                                 f"with an InputError (call ctx.require_... in bind): {exc}") from exc
+        if built is not None:
             raise TermCheckError(f"{name}: <{field}> '{wrong}' (a name the synthetic problem has not) was accepted "
                                  "(expected an InputError naming it, raised from bind with ctx.require_...)")
         if wrong not in (outcome.not_built or ""):

@@ -1,9 +1,10 @@
 """Small problems of the personalization tools (MTP, SynX, MTLI, NCP, GCP, JMP) for checking
 their terms (:func:`nmsm.testing.check_term`), generated in code from known answers.
 
-Each builder adds the term to the tool's own problem (the tool's context and reduction) and
-returns a :class:`SyntheticProblem` whose ``tracked`` point is one where the synthetic data
-are reproduced exactly, so a tracking term is zero there:
+Each builder returns the tool's own problem and context (the tool's reduction), to which
+:meth:`SyntheticProblem.add_term` adds the term under check as the tool does, and a
+``tracked`` point where the synthetic data are reproduced exactly, so a tracking term is
+zero there:
 
 =========  ======================================================================================
 tool       problem
@@ -50,18 +51,26 @@ MTP_MUSCLES = ("muscle_0", "muscle_1", "muscle_2")
 
 @attrs.define(eq=False)
 class SyntheticProblem:
-    """A tool's problem with the term under check added.
+    """A tool's problem, ready for the term under check.
 
     ``tracked``: scaled variables (``problem.initial_scaled()`` order) where the synthetic data
-    are reproduced exactly, or None where the problem has no such point. ``shape_problem``:
-    what is wrong with the term's raw quantity for this tool (None if nothing), for tools
-    whose reduction expects a form (GCP: one block per foot).
+    are reproduced exactly, or None where the problem has no such point. ``add``: adds a bound
+    term to the problem as the tool does (default ``problem.add_term(term, context)``).
+    ``form_problem``: what is wrong with a term's raw quantity for this tool's reduction (None
+    if nothing), for tools whose reduction expects a form (GCP: one block per foot).
     """
 
     problem: OptimizationProblem
     context: Any
     tracked: np.ndarray | None
-    shape_problem: str | None = None
+    add: Callable[[Term], None] | None = None
+    form_problem: Callable[[Term], str | None] | None = None
+
+    def add_term(self, term: Term) -> None:
+        if self.add is not None:
+            self.add(term)
+        else:
+            self.problem.add_term(term, self.context)
 
 
 @functools.cache
@@ -97,20 +106,18 @@ def _mtp_case() -> tuple[Any, Any]:
     return attrs.evolve(data, trials=trials), truth
 
 
-def mtp_problem(term: Term, tool: str) -> SyntheticProblem:
-    """The MTP task (``tool`` "MTP") or its Synergy Extrapolation terms ("SynX")."""
+def mtp_problem(tool: str) -> SyntheticProblem:
+    """The MTP task; its context serves the MTP and the Synergy Extrapolation (SynX) terms."""
     from nmsm.tools.mtp.evaluation import initial_fiber_lengths
     from nmsm.tools.mtp.problem import TaskSettings, build_task_problem
 
     data, truth = _mtp_case()
-    terms = (term,)
-    task = TaskSettings(cost_terms=terms if tool == "MTP" else (), synx_terms=terms if tool == "SynX" else ())
-    problem, ctx = build_task_problem(data, truth, task, initial_fiber_lengths(data), name="check_term MTP")
+    problem, ctx = build_task_problem(data, truth, TaskSettings(), initial_fiber_lengths(data), name="check_term MTP")
     return SyntheticProblem(problem, ctx, problem.initial_scaled())
 
 
 # ----------------------------------------------------------------------------------- MTLI
-def mtli_problem(term: Term, tool: str) -> SyntheticProblem:
+def mtli_problem(tool: str) -> SyntheticProblem:
     """The MTLI problem of the module docstring (scale factors, stress scale optimized)."""
     from nmsm.tools.mtp.mtli import MtliOptions, build_mtli_problem
     from nmsm.tools.mtp.mtli_model import PassiveTrial, mtli_quantities
@@ -128,7 +135,7 @@ def mtli_problem(term: Term, tool: str) -> SyntheticProblem:
                                   maximum_muscle_stress=options.maximum_muscle_stress)
     passive = attrs.evolve(passive, inverse_dynamics_moments=np.array(cs.evalf(moments[0])))
     problem, ctx = build_mtli_problem(muscles, [trial.muscle_tendon_length], [passive], data.fiber_length_groups,
-                                      [term], options)
+                                      [], options)
     return SyntheticProblem(problem, ctx, problem.initial_scaled())
 
 
@@ -169,12 +176,12 @@ def _ncp_case() -> tuple[Any, Any]:
     return attrs.evolve(inputs, trials=(trial,)), guess
 
 
-def ncp_problem(term: Term, tool: str) -> SyntheticProblem:
+def ncp_problem(tool: str) -> SyntheticProblem:
     """The NCP problem of the module docstring (no proximal term)."""
     from nmsm.tools.ncp.problem import build_problem
 
     inputs, guess = _ncp_case()
-    built = build_problem(inputs, [term], guess, name="check_term NCP", proximal_weight=0.0)
+    built = build_problem(inputs, [], guess, name="check_term NCP", proximal_weight=0.0)
     return SyntheticProblem(built.problem, built.context, built.problem.initial_scaled())
 
 
@@ -194,7 +201,7 @@ def _gcp_case() -> tuple[Any, list[Any], Any]:
     return settings, feet, attrs.evolve(settings.tasks[0], **flags)
 
 
-def gcp_problem(term: Term, tool: str) -> SyntheticProblem:
+def gcp_problem(tool: str) -> SyntheticProblem:
     """The GCP task of the module docstring (foot coordinates not lifted)."""
     from nmsm.tools.gcp.problem import build_task_problem
     from nmsm.tools.gcp.state import GcpState
@@ -202,14 +209,18 @@ def gcp_problem(term: Term, tool: str) -> SyntheticProblem:
     settings, feet, task = _gcp_case()
     state = GcpState.initial(settings, feet)
     state.spring_constants = np.linspace(2000.0, 3000.0, state.spring_constants.size)  # not all equal
-    built = build_task_problem(feet, state, task, [term], name="check_term GCP", lift=False)
-    shape = None
-    if isinstance(term, CostTerm):
+    built = build_task_problem(feet, state, task, [], name="check_term GCP", lift=False)
+
+    def form_problem(term: Term) -> str | None:
+        if not isinstance(term, CostTerm):
+            return None
         blocks = term.normalized(built.context)
-        if not isinstance(blocks, (tuple, list)) or len(blocks) != len(feet):
-            shape = (f"quantity must be a tuple with one block per foot ({len(feet)} here), got "
-                     f"{type(blocks).__name__}" + (f" of {len(blocks)}" if isinstance(blocks, (tuple, list)) else ""))
-    return SyntheticProblem(built.problem, built.context, None, shape)
+        if isinstance(blocks, (tuple, list)) and len(blocks) == len(feet):
+            return None
+        got = f"a {type(blocks).__name__}" + (f" of {len(blocks)}" if isinstance(blocks, (tuple, list)) else "")
+        return f"quantity must be a tuple with one block per foot ({len(feet)} here), got {got}"
+
+    return SyntheticProblem(built.problem, built.context, None, form_problem=form_problem)
 
 
 # ------------------------------------------------------------------------------------ JMP
@@ -232,17 +243,14 @@ def _jmp_case() -> tuple[Any, Any]:
     return MarkerKinematics(model, design.marker_names, design.parameters), design
 
 
-def jmp_problem(term: Term, tool: str, n_frames: int = 3) -> SyntheticProblem:
+def jmp_problem(tool: str, n_frames: int = 3) -> SyntheticProblem:
     """JMP's simultaneous problem (every frame's free coordinates and the joint parameters),
-    its residuals frame after frame as JMP's own solver builds them."""
+    a term's residuals frame after frame as JMP's own solver maps them."""
     from nmsm.tools.jmp.problem import JmpContext
 
     kin, design = _jmp_case()
     n_markers = kin.n_markers
     ctx = JmpContext(kin, cs.SX.sym("x_exp", 3 * n_markers), cs.SX.sym("sqrt_w", n_markers), n_markers * n_frames)
-    term.bind(ctx)
-    residuals = term.residuals(ctx) if isinstance(term, CostTerm) else term.bounded(ctx)[0]
-    frame = cs.Function("frame", [kin.q, kin.p, ctx.x_exp, ctx.sqrt_w], [cs.SX(residuals)])
     rng = np.random.default_rng(3)
     q = kin.initial_free()[None, :] + 0.1 * rng.standard_normal((n_frames, kin.n_free))
     q = np.clip(q, kin.lower + 0.01, kin.upper - 0.01)
@@ -254,17 +262,25 @@ def jmp_problem(term: Term, tool: str, n_frames: int = 3) -> SyntheticProblem:
     p_var = problem.variable("p", p, design.lower, design.upper, scale=1.0)
     x_par = problem.parameter("x_exp", x_exp.T)
     w_par = problem.parameter("sqrt_w", np.ones((n_markers, n_frames)))
-    stacked = frame.map(n_frames)(q_var, p_var, x_par, w_par)
-    if isinstance(term, CostTerm):
-        problem.add_cost(term.label, stacked, term=term)
-    else:
-        _, lower, upper = term.bounded(ctx)
-        problem.add_constraint(term.label, stacked, lower, upper, term=term)
-    return SyntheticProblem(problem, ctx, problem.initial_scaled())
+
+    def add(term: Term) -> None:
+        term.bind(ctx)
+        if isinstance(term, CostTerm):
+            residuals, lower, upper = term.residuals(ctx), None, None
+        else:
+            residuals, lower, upper = term.bounded(ctx)
+        frame = cs.Function("frame", [kin.q, kin.p, ctx.x_exp, ctx.sqrt_w], [cs.SX(residuals)])
+        stacked = frame.map(n_frames)(q_var, p_var, x_par, w_par)
+        if lower is None:
+            problem.add_cost(term.label, stacked, term=term)
+        else:
+            problem.add_constraint(term.label, stacked, lower, upper, term=term)
+
+    return SyntheticProblem(problem, ctx, problem.initial_scaled(), add=add)
 
 
 #: tool -> builder of its synthetic problem
-BUILDERS: dict[str, Callable[[Term, str], SyntheticProblem]] = {
+BUILDERS: dict[str, Callable[[str], SyntheticProblem]] = {
     "MTP": mtp_problem,
     "SynX": mtp_problem,
     "MTLI": mtli_problem,

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from nmsm.core.ocp import ContinuousCost
+from nmsm.core.term import CostTerm
 from nmsm.core.registry import get_registry
 from nmsm.testing import TermCheckError, check_term
 
@@ -58,10 +59,17 @@ class _CoordinateTracking(_Tracking):
     type: ClassVar[str] = "generalized_coordinate_tracking"
 
 
+def _half_derivative(x: Any) -> Any:
+    """x^2 whose CasADi derivative is x dx (half the true one): a wrong exact derivative."""
+    return x * cs.stop_diff(x, 1)
+
+
+_NUMBERS = ["declaration", "settings", "bad elements refused", "shape", "built, finite", "derivatives"]
+
+
 @pytest.mark.parametrize("cls, checks", [
-    (_Tracking, ["declaration", "settings", "bad elements refused", "built, finite", "derivatives"]),
-    (_CoordinateTracking, ["declaration", "settings", "bad elements refused", "built, finite", "derivatives",
-                           "zero at perfect tracking"]),
+    (_Tracking, _NUMBERS + ["unknown names refused"]),
+    (_CoordinateTracking, _NUMBERS + ["zero at perfect tracking", "unknown names refused"]),
 ])
 def test_a_correct_term_passes_every_check(cls: type, checks: list[str]) -> None:
     report = check_term(cls)
@@ -81,10 +89,10 @@ class _OffsetTracking(_Tracking):
 
 @attrs.frozen(kw_only=True)
 class _HiddenDerivative(_Tracking):
-    """(q_exp - q)^2 with its derivative hidden from CasADi (exact derivative 0)."""
+    """(q_exp - q)^2 with one factor hidden from CasADi (exact derivative half the true one)."""
 
     def quantity(self, ctx: Any) -> Any:
-        return cs.stop_diff(super().quantity(ctx) ** 2, 1)
+        return _half_derivative(super().quantity(ctx))
 
 
 @attrs.frozen(kw_only=True)
@@ -103,15 +111,161 @@ class _MisspelledQuantity(_Tracking):
         return ctx.coordinat(self.coordinate)
 
 
+@attrs.frozen(kw_only=True)
+class _TrackingWithoutNameCheck(_Tracking):
+    """q_exp - q (rad) with a bind that checks nothing: a wrong name fails only while building."""
+
+    def bind(self, ctx: Any) -> None:
+        pass
+
+
+@attrs.frozen(kw_only=True)
+class _DataOnly(_Tracking):
+    """The tracked coordinate alone: data, no design variable."""
+
+    def quantity(self, ctx: Any) -> Any:
+        return ctx.tracked_coordinate(self.coordinate)
+
+
 @pytest.mark.parametrize("cls, message", [
     (_OffsetTracking, "not zero on the tracked motion"),
     (_HiddenDerivative, "differs from finite differences"),
     (_SizeTracking, r"\(K, 1\)|column|shape"),
     (_MisspelledQuantity, "coordinat"),
+    (_TrackingWithoutNameCheck, "check_term_no_such_coordinate.*not refused with an InputError"),
+    (_DataOnly, "does not depend on any design variable"),
 ])
 def test_broken_terms_are_refused(cls: type, message: str) -> None:
     with pytest.raises(TermCheckError, match=message):
         check_term(cls)
+
+
+# ----- the personalization tools' synthetic problems -------------------------------------------
+def _personalization(tool: str, type_: str, quantity: Any, *, base: type = CostTerm) -> type:
+    """A cost term of ``tool`` whose raw quantity is ``quantity(ctx)``, as a plugin would write it."""
+
+    @attrs.frozen(kw_only=True)
+    class Probe(base):
+        """A probe term of check_term's tests (units of its quantity)."""
+
+        tools: ClassVar[frozenset[str]] = frozenset({tool})
+
+        def quantity(self, ctx: Any) -> Any:
+            return quantity(ctx)
+
+    Probe.type = type_
+    return Probe
+
+
+def _mtp_moments(ctx: Any) -> Any:
+    return ctx.moment_errors(synx=False)
+
+
+def _gcp_forces(ctx: Any) -> Any:
+    return tuple(ctx.force_errors(foot, [1]) for foot in range(ctx.n_feet))
+
+
+def _jmp_markers(ctx: Any) -> Any:
+    return ctx.marker_position_errors()
+
+
+@pytest.mark.parametrize("tool, quantity", [
+    ("MTP", _mtp_moments),
+    ("SynX", lambda ctx: ctx.moment_errors(synx=True)),
+    ("MTLI", lambda ctx: cs.vertcat(*ctx.passive_force)),
+    ("NCP", lambda ctx: ctx.moment_errors()),
+    ("GCP", _gcp_forces),
+    ("JMP", _jmp_markers),
+])
+def test_a_correct_personalization_term_passes_every_check(tool: str, quantity: Any) -> None:
+    report = check_term(_personalization(tool, "check_term_probe", quantity))
+    assert report.passed == _NUMBERS
+    assert report.not_built is None
+
+
+@pytest.mark.parametrize("tool, quantity, zero", [
+    ("MTP", _mtp_moments, True),
+    ("NCP", lambda ctx: ctx.moment_errors(), True),
+    ("JMP", _jmp_markers, True),
+    ("MTLI", lambda ctx: cs.vertcat(*[m - cs.DM(t.inverse_dynamics_moments)
+                                      for t, m in zip(ctx.passive_trials, ctx.passive_moments)]), True),
+])
+def test_a_personalization_tracking_term_is_zero_where_the_data_are_reproduced(tool: str, quantity: Any,
+                                                                               zero: bool) -> None:
+    report = check_term(_personalization(tool, "check_term_probe", quantity), zero_at_tracking=zero)
+    assert report.passed[-1] == "zero at perfect tracking"
+
+
+@pytest.mark.parametrize("tool, quantity, message", [
+    ("MTP", lambda ctx: _mtp_moments(ctx) + 0.1, "not zero on the tracked motion"),
+    ("NCP", lambda ctx: ctx.moment_errors() + 0.1, "not zero on the tracked motion"),
+    ("JMP", lambda ctx: _jmp_markers(ctx) + 1e-3, "not zero on the tracked motion"),
+    ("MTP", lambda ctx: _half_derivative(_mtp_moments(ctx)), "differs from finite differences"),
+    ("NCP", lambda ctx: _half_derivative(ctx.moment_errors()), "differs from finite differences"),
+    ("GCP", lambda ctx: tuple(_half_derivative(b) for b in _gcp_forces(ctx)), "differs from finite differences"),
+    ("GCP", lambda ctx: ctx.force_errors(0, [1]), "one block per foot"),
+    ("MTP", lambda ctx: cs.MX(0, 1), "no residual"),
+    ("NCP", lambda ctx: ctx.inputs.trials[0].moments, "does not depend on any design variable"),
+    ("MTLI", lambda ctx: ctx.no_such_quantity, "no_such_quantity"),
+])
+def test_broken_personalization_terms_are_refused(tool: str, quantity: Any, message: str) -> None:
+    cls = _personalization(tool, "check_term_probe", quantity)
+    with pytest.raises(TermCheckError, match=message):
+        check_term(cls, zero_at_tracking=message.startswith("not zero"))
+
+
+def test_zero_at_tracking_on_a_problem_without_a_tracked_point_is_refused() -> None:
+    with pytest.raises(TermCheckError, match="no point where its data are tracked exactly"):
+        check_term(_personalization("GCP", "check_term_probe", _gcp_forces), zero_at_tracking=True)
+
+
+# ----- derivatives of quantities that jump between mesh intervals ------------------------------
+@attrs.frozen(kw_only=True)
+class _Jerk(_Tracking):
+    """d/dt of the coordinate's acceleration (rad/s^3): a control, free to jump between intervals."""
+
+    type: ClassVar[str] = "check_term_probe_jerk"
+
+    def quantity(self, ctx: Any) -> Any:
+        return ctx.differentiate(ctx.acceleration(self.coordinate))
+
+
+@attrs.frozen(kw_only=True)
+class _SpeedRate(_Tracking):
+    """d/dt of the coordinate's speed (rad/s^2): a state, continuous across intervals."""
+
+    type: ClassVar[str] = "check_term_probe_speed_rate"
+
+    def quantity(self, ctx: Any) -> Any:
+        return ctx.differentiate(ctx.speed(self.coordinate))
+
+
+def test_differentiating_a_control_warns_once_per_term() -> None:
+    from nmsm.core.ocp import DiscontinuousDerivativeWarning
+    from nmsm.io.term_spec import SourceRef
+    from nmsm.testing.pendulum_problem import build_pendulum_problem
+
+    first = _Jerk(coordinate="q0", source=SourceRef("jerk.xml", 4))
+    same = _Jerk(coordinate="q1", source=SourceRef("jerk.xml", 4))  # the same <RCNLCostTerm>, another item
+    other = _Jerk(coordinate="q1", source=SourceRef("jerk.xml", 9))
+    with pytest.warns(DiscontinuousDerivativeWarning) as caught:
+        build_pendulum_problem([first, same, other])
+    messages = [str(w.message) for w in caught if issubclass(w.category, DiscontinuousDerivativeWarning)]
+    assert len(messages) == 2
+    assert messages[0].startswith("jerk.xml:4: term 'check_term_probe_jerk'") and "jump" in messages[0]
+    assert messages[1].startswith("jerk.xml:9: ")
+    report = check_term(_Jerk)
+    assert len(report.warnings) == 1 and "depends on the controls" in report.warnings[0]
+
+
+def test_differentiating_a_state_does_not_warn() -> None:
+    from nmsm.core.ocp import DiscontinuousDerivativeWarning
+    from nmsm.testing.pendulum_problem import build_pendulum_problem
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DiscontinuousDerivativeWarning)
+        build_pendulum_problem([_SpeedRate(coordinate="q0")])
+    assert check_term(_SpeedRate).warnings == []
 
 
 def test_a_term_without_evaluation_is_refused() -> None:
