@@ -33,6 +33,22 @@ def test_symmetry_term_conforms() -> None:
     assert report.not_built and "synerg" in report.not_built  # the pendulum has no synergy controller
 
 
+@pytest.mark.parametrize("amplitude", ["rms", "mean", "peak"])
+def test_symmetry_term_builds_with_exact_derivatives_on_any_pair_of_controls(amplitude: str) -> None:
+    """The term compares two controls' amplitudes: on check_term's pendulum, its two torque
+    controls stand for a pair of synergies."""
+    report = check_term(SynergyAmplitudeSymmetry, {"synergy_pairs": "q0_moment:q1_moment", "amplitude": amplitude})
+    assert report.passed == ["declaration", "settings", "bad elements refused", "shape", "built, finite",
+                             "derivatives"]
+    assert report.not_built is None and report.warnings == []
+
+
+def test_an_unknown_control_in_a_pair_is_refused_naming_it() -> None:
+    report = check_term(SynergyAmplitudeSymmetry, {"synergy_pairs": "q0_moment:RightSynergies_9"})
+    assert report.not_built is not None
+    assert "RightSynergies_9" in report.not_built and "<synergy_pairs>" in report.not_built
+
+
 @pytest.mark.parametrize("pairs", ["RightSynergies_1", "a:", ""])
 def test_malformed_pairs_are_refused_naming_the_element(pairs: str) -> None:
     spec = TermSpec("cost", SynergyAmplitudeSymmetry.type, {"is_enabled": "true", "synergy_pairs": pairs},

@@ -7,7 +7,9 @@ controllers: a torque-controlled coordinate (``c``, ``c_moment``), a synergy act
 ``controller_slope_minimization`` du/dt (per second) of the control's interpolating polynomial
                                   in each mesh interval (the original differentiates a
                                   not-a-knot cubic spline of u); ``normalize_by_final_time``
-                                  defaults to false as in the original
+                                  defaults to false as in the original. Controls may jump
+                                  between mesh intervals, which this derivative does not see:
+                                  building it gives a DiscontinuousDerivativeWarning
 ``controller_shape_tracking``     u_init - k·u, k = (u·u_init)/(u·u) (DO)
 """
 

@@ -523,8 +523,8 @@ class TreatmentContext(GridView):
             f"{where}term '{term.type}' ({type(term).__qualname__}) differentiates a quantity that depends on the "
             "controls (accelerations, loads, torque controls or activations), which may jump from one mesh "
             "interval to the next: ctx.differentiate does not see those jumps, so minimising or bounding this "
-            "derivative can raise the true one while the solver reports success. Differentiate a state "
-            "(coordinate or speed) instead, or see docs/plugins.md 'Derivatives of the context'",
+            "derivative can raise the true one while the solver reports success. Penalise the quantity "
+            "itself or the derivative of a state (coordinate or speed); docs/plugins.md 'Derivatives of the context'",
             DiscontinuousDerivativeWarning, stacklevel=2)
 
     def reduce_cost(self, term: CostTerm, normalized: Any) -> Any:
