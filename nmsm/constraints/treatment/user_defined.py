@@ -26,6 +26,9 @@ class UserDefinedConstraint(PathConstraint):
 
     type: ClassVar[str] = "user_defined"
     tools: ClassVar[frozenset[str]] = frozenset({"DO"})
+    #: the pendulum of nmsm.testing.check_term: the final forward speed of its tip marker
+    check_example: ClassVar[Mapping[str, str]] = {"function_name": "footSpeedConstraint",
+                                                  "constraint_term_type": "terminal", "marker_name": "tip_1"}
     function_name: str
     constraint_term_type: str = "path"
     options: Mapping[str, str] = options_field()

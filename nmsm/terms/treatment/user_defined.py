@@ -27,6 +27,9 @@ class UserDefinedCost(ContinuousCost):
 
     type: ClassVar[str] = "user_defined"
     tools: ClassVar[frozenset[str]] = frozenset({"DO"})
+    #: the pendulum of nmsm.testing.check_term: the final forward speed of its tip marker
+    check_example: ClassVar[Mapping[str, str]] = {"function_name": "footSpeedCost", "cost_term_type": "discrete",
+                                                  "marker_name": "tip_1", "target_speed": "1.0"}
     function_name: str
     cost_term_type: str = "continuous"
     options: Mapping[str, str] = options_field()
