@@ -127,7 +127,25 @@ class _DataOnly(_Tracking):
         return ctx.tracked_coordinate(self.coordinate)
 
 
+@attrs.frozen(kw_only=True)
+class _VagueNameCheck(_Tracking):
+    """Refuses an unknown coordinate without saying which."""
+
+    def bind(self, ctx: Any) -> None:
+        if self.coordinate not in ctx.state_coordinates:
+            raise self.error("unknown coordinate")
+
+
+@attrs.frozen(kw_only=True)
+class _AcceptsZeroError(_Tracking):
+    """Redeclares max_allowable_error without the base's validator (0 would divide by zero)."""
+
+    max_allowable_error: float = 1.0
+
+
 @pytest.mark.parametrize("cls, message", [
+    (_VagueNameCheck, "check_term_no_such_coordinate' was refused, but the message does not name it"),
+    (_AcceptsZeroError, r"\{'max_allowable_error': '0'\} were accepted"),
     (_OffsetTracking, "not zero on the tracked motion"),
     (_HiddenDerivative, "differs from finite differences"),
     (_SizeTracking, r"\(K, 1\)|column|shape"),
