@@ -137,6 +137,8 @@ def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str
     if not (isinstance(cls, type) and issubclass(cls, (CostTerm, ConstraintTerm))):
         raise TermCheckError(f"{name} is not a subclass of nmsm.core.term.CostTerm or ConstraintTerm")
     _check_declaration(cls, name, report)
+    if tool is not None and tool not in cls.tools:
+        raise TermCheckError(f"{name}: check_term(tool='{tool}'), but the class accepts {sorted(cls.tools)}")
     tool = tool or (sorted(cls.tools & TREATMENT_TOOLS) or sorted(cls.tools & set(BUILDERS))
                     or sorted(cls.tools))[0]
     elements = _example_elements(cls, example)

@@ -232,6 +232,15 @@ def test_broken_personalization_terms_are_refused(tool: str, quantity: Any, mess
         check_term(cls, zero_at_tracking=message.startswith("not zero"))
 
 
+def test_a_term_is_checked_for_the_tool_asked() -> None:
+    from nmsm.core.registry import get_registry
+
+    penalty = get_registry().get("cost", "muscle_excitation_penalty", "SynX")  # MTP and SynX
+    assert check_term(penalty, tool="SynX").passed == _NUMBERS
+    with pytest.raises(TermCheckError, match=r"tool='GCP'.*accepts \['MTP', 'SynX'\]"):
+        check_term(penalty, tool="GCP")
+
+
 def test_zero_at_tracking_on_a_problem_without_a_tracked_point_is_refused() -> None:
     with pytest.raises(TermCheckError, match="no point where its data are tracked exactly"):
         check_term(_personalization("GCP", "check_term_probe", _gcp_forces), zero_at_tracking=True)
