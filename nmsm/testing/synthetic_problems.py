@@ -34,7 +34,7 @@ import atexit
 import functools
 import shutil
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +44,6 @@ import numpy as np
 
 from nmsm.core.problem import OptimizationProblem
 from nmsm.core.term import CostTerm, Term
-
-#: muscles of the MTP, SynX and MTLI problems
-MTP_MUSCLES = ("muscle_0", "muscle_1", "muscle_2")
 
 
 @attrs.define(eq=False)
@@ -300,5 +297,5 @@ ZERO_AT_TRACKED: frozenset[tuple[str, str]] = frozenset({
 })
 
 
-__all__ = ["BUILDERS", "MTP_MUSCLES", "SyntheticProblem", "ZERO_AT_TRACKED", "gcp_problem", "jmp_problem",
+__all__ = ["BUILDERS", "SyntheticProblem", "ZERO_AT_TRACKED", "gcp_problem", "jmp_problem",
            "mtli_problem", "mtp_problem", "ncp_problem"]
