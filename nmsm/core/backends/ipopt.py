@@ -44,6 +44,21 @@ def resolve_linear_solver(requested: str | None) -> str:
     return name
 
 
+def jacobian_direction_options(problem: OptimizationProblem) -> dict[str, Any]:
+    """``nlpsol`` options that compute the constraint Jacobian with the AD mode needing
+    fewer sweeps: reverse (one sweep per colour of the rows) unless the columns need fewer
+    colours than the rows (then forward). CasADi's own choice leans to forward mode,
+    which is slow for collocation problems whose per-point functions have many inputs
+    and few outputs."""
+    g, _, _ = problem.constraint_vector()
+    if g.numel() == 0:
+        return {}
+    pattern = cs.jacobian_sparsity(g, problem.scaled_vector())
+    forward = pattern.uni_coloring().size2()
+    reverse = pattern.T.uni_coloring().size2()
+    return {"oracle_options": {"ad_weight": 1.0 if reverse <= forward else 0.0}}
+
+
 def solve_ipopt(
     problem: OptimizationProblem,
     *,

@@ -38,6 +38,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from nmsm.core.backends.ipopt import jacobian_direction_options
 from nmsm.core.console import announce, console_enabled, summarize
 from nmsm.core.interrupts import SolveInterrupted
 from nmsm.core.problem import Solution
@@ -282,7 +283,9 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
     trial = settings.trial_name
     log = log_dir / f"{trial}_ipopt.log" if log_dir is not None else None
     try:
-        solution = prepared.built.problem.solve("ipopt", **_ipopt_kwargs(prepared, opts, log, initial_cost))
+        problem = prepared.built.problem
+        solution = problem.solve("ipopt", casadi_options=jacobian_direction_options(problem),
+                                 **_ipopt_kwargs(prepared, opts, log, initial_cost))
     except SolveInterrupted as stop:
         if results is not None and stop.solution is not None:
             saved = _write_stopped(prepared, stop.solution, trial, results, log)
