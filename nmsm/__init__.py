@@ -26,13 +26,35 @@ def _path(value: Any, what: str) -> str | os.PathLike[str]:
     return value
 
 
-def run(settings_file: str | os.PathLike[str], **options: Any) -> Any:
-    """Run the tool named by the settings file's tool element (as ``nmsm run``)."""
+def run(settings_file: str | os.PathLike[str], *, plots: bool = False, **options: Any) -> Any:
+    """Run the tool named by the settings file's tool element (as ``nmsm run``); ``options``
+    are the tool's own. ``plots=True`` then draws the figures of the results folder (and of
+    each results folder below it) into its ``plots/``, as ``nmsm plot RESULTS`` does; a
+    folder whose figures fail raises :class:`~nmsm.errors.NmsmError` after the others are drawn."""
     from nmsm.tools.dispatch import run_settings_file
 
     if options.get("results_directory") is not None:
         _path(options["results_directory"], "nmsm.run(results_directory=...)")
-    return run_settings_file(_path(settings_file, "nmsm.run(settings_file)"), **options)
+    outcome = run_settings_file(_path(settings_file, "nmsm.run(settings_file)"), **options)
+    if plots:
+        _draw_figures(outcome)
+    return outcome
+
+
+def _draw_figures(outcome: Any) -> None:
+    """The figures of the results folder a tool's run returned (its ``results_directory``, or
+    the folder itself)."""
+    from pathlib import Path
+
+    from nmsm.errors import NmsmError
+    from nmsm.plots.cli import plot_tree
+
+    where = outcome if isinstance(outcome, Path) else getattr(outcome, "results_directory", None)
+    if where is None:
+        raise NmsmError(f"plots=True: the run returned no results folder to draw ({type(outcome).__name__})")
+    _, errors = plot_tree(where, log=lambda text: None)
+    if errors:
+        raise NmsmError("no figures for " + "; ".join(f"{folder}: {message}" for folder, message in errors.items()))
 
 
 def run_pipeline(pipeline_file: str | os.PathLike[str], **options: Any) -> Any:

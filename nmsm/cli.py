@@ -38,7 +38,10 @@ COMMAND_MODULES: tuple[str, ...] = (
     "nmsm.tools.preprocess.cli",  # preprocess
     "nmsm.tools.ncp.cli",  # vaf
     "nmsm.plots.cli",  # plot
-    "nmsm.tools.pipeline.cli",  # pipeline, example, report, export
+    "nmsm.tools.pipeline.cli",  # pipeline
+    "nmsm.examples.cli",  # example
+    "nmsm.report.cli",  # report
+    "nmsm.interop.cli",  # export
     "nmsm.batch.cli",  # batch
 )
 

@@ -47,7 +47,8 @@ import numpy as np
 from nmsm.core.plugin_bases import ControlSpec, Controller, StateSpec
 from nmsm.interop.moco_trajectory import MocoColumns, muscle_activation_path, muscle_control_path
 from nmsm.core.controller_setup import ControllerSetup, name_list, setting
-from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
+from nmsm.model.muscle_model import MuscleModel
+from nmsm.model.surrogate_fitting import load_surrogate
 
 PREFIX = "activation:"
 EXCITATION_PREFIX = "excitation:"

@@ -8,7 +8,7 @@ synergy vectors ``W`` (S, M) from ``synergyWeights.sto`` of the initial guess di
 (rows = synergies, columns = muscles), constant unless ``optimize_synergy_vectors``
 (then static design variables in ``[0, synergy_vector_normalization_value]``). Muscle
 forces and moments use the surrogate geometry and the Hill model
-(:mod:`nmsm.tools.treatment.muscles`); the controller applies the muscle moments on the
+(:mod:`nmsm.model.muscle_model`); the controller applies the muscle moments on the
 surrogate coordinates.
 
 Normalization (``synergy_vector_normalization_method``): ``sum`` - each vector row is
@@ -38,7 +38,8 @@ from nmsm.core.plugin_bases import ControlSpec, Controller
 from nmsm.interop.moco_trajectory import MocoColumns, muscle_control_path
 from nmsm.io.storage import Table
 from nmsm.core.controller_setup import ControllerSetup, name_list, setting
-from nmsm.tools.treatment.muscles import MuscleModel, load_surrogate
+from nmsm.model.muscle_model import MuscleModel
+from nmsm.model.surrogate_fitting import load_surrogate
 
 PREFIX = "synergy:"
 WEIGHTS_PARAMETER = "synergy_weights"

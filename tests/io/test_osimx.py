@@ -325,7 +325,7 @@ def test_treatment_muscle_model_rejects_an_osimx_muscle_not_in_the_model(shared_
     from nmsm.controllers.muscle import PathGeometry
     from nmsm.examples.moco2d import MUSCLE_COORDINATES
     from nmsm.model import load_model
-    from nmsm.tools.treatment.muscles import MuscleModel
+    from nmsm.model.muscle_model import MuscleModel
 
     model = load_model(shared_data / "moco2d" / "2D_gait.osim")
     names = [m.name for m in model.muscles]

@@ -11,7 +11,7 @@ from nmsm.io.storage import Table, read_storage
 from nmsm.model import load_model
 from nmsm.model.muscle_analysis import analyze_motion, coordinate_speeds, motion_poses
 from nmsm.model.surrogate import fit_surrogate_model
-from nmsm.tools.surrogate.data import read_samples
+from nmsm.model.surrogate_data import read_samples
 
 KICK = "treatment/surrogate_kick_tutorial"
 SURROGATE_COORDINATES = ["hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r",

@@ -10,7 +10,7 @@ from nmsm.model import load_model
 from nmsm.model.muscle_geometry import MuscleGeometry
 from nmsm.model.muscle_paths import PathMuscleGeometry, evaluate_function
 from nmsm.model.surrogate import fit_surrogate_model
-from nmsm.tools.surrogate.data import read_samples
+from nmsm.model.surrogate_data import read_samples
 
 KICK = "treatment/surrogate_kick_tutorial"
 COORDINATES = ["hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r",

@@ -17,7 +17,9 @@ through :class:`~nmsm.core.results.ResultsDirectory`, task by task, never over a
         task<i>_<name>/                     per task: ik_before.mot, ik_after.mot,
                                             marker_errors_before.sto, marker_errors_after.sto (m),
                                             and the task's model when it is not the last task
-        plots/                              with plots=True (:func:`nmsm.plots.jmp.plot_jmp_results`)
+
+Figures are drawn from these files afterwards (``nmsm plot RESULTS``, ``nmsm.run(...,
+plots=True)``: :func:`nmsm.plots.jmp.plot_jmp_results`).
 
 Optimizer options of the settings are honoured: ``function_tolerance`` (relative cost
 change), ``step_tolerance`` (step relative to the variables), ``optimality_tolerance``
@@ -127,11 +129,11 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
                  function_tolerance: float | None = None, step_tolerance: float | None = None,
                  optimality_tolerance: float | None = None, max_function_evaluations: int | None = None,
                  max_iterations: int = DEFAULT_MAX_ITERATIONS, accuracy: float | None = None,
-                 plots: bool = False, quiet: bool = False, accept_unconverged: bool = False) -> JmpRun:
+                 quiet: bool = False, accept_unconverged: bool = False) -> JmpRun:
     """Run JMP as the settings file ``path`` says (see module docstring).
 
     Keyword options override the settings (``results_directory``, the optimizer tolerances,
-    ``accuracy``); ``plots=True`` also draws the figures; ``quiet`` silences the log on stdout.
+    ``accuracy``); ``quiet`` silences the log on stdout.
     A task whose optimization stopped before its tolerances (at ``max_function_evaluations``
     or ``max_iterations``) ends the run: its files and model go into
     ``<results>/last_iterate/`` with ``diagnosis.txt`` and :class:`~nmsm.errors.SolverError`
@@ -216,10 +218,6 @@ def run_settings(path: str | os.PathLike[str], *, results_directory: str | os.Pa
     if settings_copy.resolve() != Path(settings.settings_file).resolve():
         results.copy_in(settings.settings_file)
     results.write_text(LOG_FILE, "\n".join(log_lines) + "\n", unconverged=stamp)
-    if plots:
-        from nmsm.plots.jmp import plot_jmp_results
-
-        plot_jmp_results(results.path)
     return JmpRun(settings=settings, tasks=tuple(task_results), output_model=results.path / final_name,
                   results_directory=results.path, report=report, wall_time=wall)
 

@@ -7,7 +7,8 @@ solves it with IPOPT (exact gradient and Hessian, :mod:`nmsm.tools.ncp.hessian`)
 normalizes the synergies (largest weight one) and writes the results
 (:mod:`nmsm.tools.ncp.outputs`) through a staging folder, together with a copy of the
 settings file, ``commandWindowOutput.txt`` (solver summary, costs, fit metrics) and
-``ncpRunInfo.json`` (inputs used, for the plots).
+``ncpRunInfo.json`` (inputs used, for the figures that :func:`nmsm.plots.ncp.plot_ncp_results`
+draws afterwards: ``nmsm plot RESULTS``, ``nmsm.run(..., plots=True)``).
 
 Solver settings: the settings' ``max_iterations`` is IPOPT's ``max_iter``; IPOPT ``tol``
 1e-8 (the fmincon tolerances of the settings file do not translate and are not used).
@@ -193,7 +194,6 @@ def run_settings(
     tolerance: float | None = None,
     print_level: int | None = None,
     proximal_weight: float = PROXIMAL_WEIGHT,
-    plots: bool = False,
     accept_unconverged: bool = False,
     **ipopt: Any,
 ) -> NcpRun:
@@ -202,8 +202,7 @@ def run_settings(
     Options override the settings: ``results_directory``, ``enforce_bilateral_symmetry``,
     ``max_iterations``, ``tolerance`` (IPOPT ``tol``), ``print_level`` (IPOPT output, 0 quiet),
     ``proximal_weight`` (pull toward the start where the terms leave activations free, see
-    :mod:`nmsm.tools.ncp.problem`); other keyword arguments go to the IPOPT back end. ``plots=True`` also saves the NCP
-    figures (:func:`nmsm.plots.ncp.plot_ncp_results`) into ``<results>/plots``.
+    :mod:`nmsm.tools.ncp.problem`); other keyword arguments go to the IPOPT back end.
     A solve that did not converge writes its last iterate into ``<results>/last_iterate/``
     and raises :class:`~nmsm.errors.SolverError` unless ``accept_unconverged`` (:mod:`nmsm.core.unconverged`).
     """
@@ -262,10 +261,6 @@ def run_settings(
         settings_copy = out_dir / Path(settings.settings_file).name
         if settings_copy.resolve() != Path(settings.settings_file).resolve():
             shutil.copy2(settings.settings_file, stage / settings_copy.name)
-    if plots:
-        from nmsm.plots.ncp import plot_ncp_results
-
-        plot_ncp_results(out_dir, out_dir / "plots")
     summarize("NCP", summary_lines(solved, metrics, wall))
     return NcpRun(
         setup=setup,

@@ -1,8 +1,10 @@
 """Surrogate Model Creation (polynomial muscle geometry) and the Muscle Analysis command.
 
-``data``      geometry samples from a surrogate data folder (``IKData`` + ``MAData``);
 ``sampling``  Latin-hypercube poses around a motion, geometry computed through OpenSim;
-``settings``  the ``RCNLSynergyController`` surrogate settings;
-``tool``      fit / load / save a surrogate as the settings ask;
+``settings``  the ``RCNLSynergyController`` surrogate settings read from a settings file;
+``accuracy``  the held-out accuracy table;
 ``cli``       ``nmsm surrogate`` and ``nmsm muscle-analysis``.
+
+Fitting, loading and saving a surrogate (what the controllers need as well) is model code:
+:mod:`nmsm.model.surrogate_fitting`, with the sample reader :mod:`nmsm.model.surrogate_data`.
 """

@@ -95,7 +95,7 @@ def _fit(args: argparse.Namespace, staged: StagedOutputs) -> tuple[Any, Path, bo
     from nmsm.io.storage import read_storage
     from nmsm.model.surrogate import fit_surrogate_model
     from nmsm.tools.surrogate.settings import read_surrogate_settings
-    from nmsm.tools.surrogate.tool import fit_from_data_directory, surrogate_from_settings
+    from nmsm.model.surrogate_fitting import fit_from_data_directory, surrogate_from_settings
 
     settings = read_surrogate_settings(args.settings) if args.settings else None
     _check_outputs(args, settings)
@@ -154,7 +154,7 @@ def _surrogate(args: argparse.Namespace) -> int:
     """``nmsm surrogate``: outputs checked, the surrogate fitted; its file and the samples
     (``--write-samples``) moved into place together."""
     from nmsm.io.output_file import staged_outputs
-    from nmsm.tools.surrogate.tool import accuracy_report
+    from nmsm.tools.surrogate.accuracy import accuracy_report
 
     with staged_outputs() as staged:
         model, path, saved = _fit(args, staged)

@@ -5,11 +5,10 @@ Elements read (settings-xml.md; defaults in brackets):
 (required), ``epsilon`` [1e-4], ``surrogate_model_polynomial_degree`` [5],
 ``load_surrogate_model`` [false], ``save_surrogate_model`` [false],
 ``surrogate_model_file_name`` [surrogateMuscles.mat]. The model is the tool's
-``input_model_file``.
-
-The original keeps the fitted model in ``surrogateMuscles.mat`` in MATLAB's current
-folder (MATLAB function handles). nmsm keeps it as JSON next to the settings file: the
-file name's extension is replaced by ``.json`` (``surrogateMuscles.json``).
+``input_model_file``. The result, a :class:`~nmsm.model.surrogate_fitting.SurrogateSettings`,
+is what :func:`~nmsm.model.surrogate_fitting.surrogate_from_settings` fits or loads; the
+fitted model is kept as JSON next to the settings file
+(:func:`~nmsm.model.surrogate_fitting.surrogate_model_path`).
 ``perform_latin_hypercube_sampling`` and its two options are parsed by the original
 but unused by its treatment tools; nmsm ignores them with a warning when true.
 """
@@ -21,37 +20,12 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import attrs
+from nmsm.model.surrogate_fitting import DEFAULT_FILE_NAME, SurrogateSettings, surrogate_model_path
 
 if TYPE_CHECKING:
     from nmsm.io.settings.document import SettingsDocument
 
 CONTROLLER = "RCNLSynergyController"
-#: the original's default ``<surrogate_model_file_name>``
-DEFAULT_FILE_NAME = "surrogateMuscles.mat"
-
-
-def surrogate_model_path(settings_file: str | os.PathLike[str] | None, file_name: str = DEFAULT_FILE_NAME) -> Path:
-    """Where a ``<surrogate_model_file_name>`` is kept: next to the settings file (the current
-    folder without one), as JSON (the name's extension replaced by ``.json``; Windows
-    separators accepted)."""
-    base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
-    return (base / Path(file_name.replace("\\", "/")).with_suffix(".json")).resolve()
-
-
-@attrs.frozen
-class SurrogateSettings:
-    """Where the samples are, what to fit, and where the fitted model is kept."""
-
-    model_file: Path
-    data_directory: Path
-    coordinates: tuple[str, ...]
-    epsilon: float = 1e-4
-    degree: int = 5
-    load: bool = False
-    save: bool = False
-    model_path: Path = Path("surrogateMuscles.json")
-    settings_file: Path | None = None
 
 
 def surrogate_settings_from_document(doc: SettingsDocument) -> SurrogateSettings:

@@ -62,8 +62,8 @@ import numpy as np
 
 from nmsm.core import reductions
 from nmsm.core.ocp import DiscontinuousDerivativeWarning, evaluation_of
+from nmsm.core.row_map import map_rows
 from nmsm.tools.treatment.orientation import check_sequence
-from nmsm.tools.treatment.transcription.base import map_rows
 
 if TYPE_CHECKING:
     from nmsm.core.term import ConstraintTerm, CostTerm

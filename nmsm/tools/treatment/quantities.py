@@ -1,6 +1,6 @@
 """How the treatment context's quantities are computed: one lazily built, cached CasADi
 expression per (grid, quantity), model quantities as per-point SX functions mapped over a grid's
-rows (:func:`~nmsm.tools.treatment.transcription.base.map_rows`).
+rows (:func:`~nmsm.core.row_map.map_rows`).
 
 Terms never use this class directly: they read it through the views of
 :mod:`nmsm.tools.treatment.context` (:class:`~nmsm.tools.treatment.context.GridView`,
@@ -16,9 +16,10 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core.function_names import function_name
+from nmsm.core.row_map import map_rows
 from nmsm.tools.treatment.context import GridView
 from nmsm.tools.treatment.orientation import euler_angles
-from nmsm.tools.treatment.transcription.base import Trajectory, map_rows
+from nmsm.tools.treatment.transcription.base import Trajectory
 
 if TYPE_CHECKING:
     from nmsm.tools.treatment.problem_data import TreatmentData

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from nmsm.errors import InputError
 from nmsm.io.settings.document import SettingsDocument
-from nmsm.tools.surrogate.settings import DEFAULT_FILE_NAME, surrogate_model_path
+from nmsm.model.surrogate_fitting import DEFAULT_FILE_NAME, surrogate_model_path
 
 #: controllers with a surrogate data folder
 CONTROLLERS = ("RCNLSynergyController", "RCNLMuscleController")

@@ -12,7 +12,7 @@ import pytest
 
 from nmsm.errors import InputError
 from nmsm.tools.surrogate.sampling import opensim_samples
-from nmsm.tools.surrogate.tool import fit_from_data_directory
+from nmsm.model.surrogate_fitting import fit_from_data_directory
 
 KICK = Path("treatment") / "surrogate_kick_tutorial"
 

@@ -18,10 +18,10 @@ from nmsm.cli import main as nmsm_main
 from nmsm.errors import InputError
 from nmsm.io.storage import read_storage, write_storage
 from nmsm.model.surrogate import SurrogateModel, fit_surrogate_model
-from nmsm.tools.surrogate.data import read_samples
+from nmsm.model.surrogate_data import read_samples
 from nmsm.tools.surrogate.sampling import opensim_samples, poses_around_motion
 from nmsm.tools.surrogate.settings import read_surrogate_settings
-from nmsm.tools.surrogate.tool import fit_from_data_directory, rotational_coordinates, surrogate_from_settings
+from nmsm.model.surrogate_fitting import fit_from_data_directory, rotational_coordinates, surrogate_from_settings
 
 LENGTH_RMS_LIMIT = 0.5e-3
 ARM_RMS_LIMIT = 1.0e-3

@@ -124,7 +124,7 @@ def test_foot_reaction_is_an_equivalent_load_about_its_ground_point(shared_data:
 def test_degroote_muscle_forces_match_opensim(shared_data: Path, bridge) -> None:
     from nmsm.controllers.muscle import DeGrooteMuscleModel, PathGeometry
     from nmsm.model import load_model
-    from nmsm.tools.treatment.muscles import MuscleModel
+    from nmsm.model.muscle_model import MuscleModel
 
     path = shared_data.joinpath(*MODEL)
     model = load_model(path)

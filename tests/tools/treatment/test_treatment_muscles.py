@@ -87,7 +87,7 @@ def test_surrogate_model_file_name_is_honoured(shared_data: Path, tmp_path: Path
     ``surrogateMuscles.json`` in the treatment tools)."""
     import shutil
 
-    from nmsm.tools.treatment.muscles import _SURROGATE_CACHE
+    from nmsm.model.surrogate_fitting import _SURROGATE_CACHE
 
     folder = tmp_path / "kick"
     shutil.copytree(_folder(shared_data), folder)

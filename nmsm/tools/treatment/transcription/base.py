@@ -173,22 +173,3 @@ class Transcription(abc.ABC):
     def transcribe(self, phase: Phase, problem: OptimizationProblem, *, prefix: str = "") -> Trajectory:
         """Declare the phase's variables and defect constraints in ``problem``."""
 
-
-def map_rows(function: cs.Function, *row_matrices: Any, parallel: int = 1) -> list[cs.MX]:
-    """Evaluate a per-point function on every row of ``(n, m_i)`` inputs.
-
-    ``function`` takes column vectors; the result is one ``(n, k_j)`` MX per output. With
-    ``parallel > 1`` the map uses CasADi's thread parallelization.
-    """
-    mats = [cs.DM(np.atleast_2d(m)) if isinstance(m, np.ndarray) else m for m in row_matrices]
-    n = max((m.shape[0] for m in mats), default=0)
-    cols = []
-    for mat in mats:
-        rows = mat.shape[0]
-        if rows not in (n, 1):
-            raise ValueError(f"map_rows: inputs have {rows} and {n} rows")
-        col = mat.T
-        cols.append(col if rows == n else cs.repmat(col, 1, n))
-    mapped = function.map(n, "thread", parallel) if parallel > 1 and n > 1 else function.map(n)
-    outs = mapped.call(cols)
-    return [cs.MX(o).T for o in outs]

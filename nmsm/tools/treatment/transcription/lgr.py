@@ -21,7 +21,8 @@ import numpy as np
 import scipy.sparse
 
 from nmsm.core.problem import OptimizationProblem, Solution
-from nmsm.tools.treatment.transcription.base import Phase, Trajectory, Transcription, map_rows
+from nmsm.core.row_map import map_rows
+from nmsm.tools.treatment.transcription.base import Phase, Trajectory, Transcription
 from nmsm.tools.treatment.transcription.radau import radau_rule
 
 

@@ -1,10 +1,16 @@
-"""Surrogate Model Creation: fit, load or save a surrogate as the settings ask.
+"""The surrogate a controller's settings describe: fitted from a surrogate data folder, or loaded.
 
-:func:`surrogate_from_settings` is what Treatment Optimization calls: with
-``load_surrogate_model`` and an existing model file it loads it (checking that it covers
-the coordinate list), else it fits from the data folder; with ``save_surrogate_model``
-it writes the model. Fitting holds out a random fifth of the poses to measure accuracy
-(stored in the model) and fits on the rest.
+:func:`surrogate_from_settings`: with ``load_surrogate_model`` and an existing model file
+it loads it (checking that it covers the coordinate list), else it fits from the data
+folder (:mod:`nmsm.model.surrogate_data`); with ``save_surrogate_model`` it writes the
+model. Fitting holds out a random fifth of the poses to measure accuracy (stored in the
+model) and fits on the rest. :func:`load_surrogate` does the same from a controller's
+settings values and keeps each fit for the process.
+
+The original keeps the fitted model in ``surrogateMuscles.mat`` in MATLAB's current
+folder (MATLAB function handles). nmsm keeps it as JSON next to the settings file: the
+file name's extension is replaced by ``.json`` (``surrogateMuscles.json``,
+:func:`surrogate_model_path`).
 """
 
 from __future__ import annotations
@@ -13,14 +19,41 @@ import os
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
+
+import attrs
 
 from nmsm.errors import InputError
 from nmsm.model.surrogate import SurrogateModel, fit_surrogate_model
-from nmsm.tools.surrogate.data import read_samples
-from nmsm.tools.surrogate.settings import SurrogateSettings
+from nmsm.model.surrogate_data import read_samples
 
 #: share of the sample poses held out to measure a new surrogate's accuracy
 HOLDOUT_FRACTION = 0.2
+#: the original's default ``<surrogate_model_file_name>``
+DEFAULT_FILE_NAME = "surrogateMuscles.mat"
+
+
+def surrogate_model_path(settings_file: str | os.PathLike[str] | None, file_name: str = DEFAULT_FILE_NAME) -> Path:
+    """Where a ``<surrogate_model_file_name>`` is kept: next to the settings file (the current
+    folder without one), as JSON (the name's extension replaced by ``.json``; Windows
+    separators accepted)."""
+    base = Path(settings_file).resolve().parent if settings_file else Path.cwd()
+    return (base / Path(file_name.replace("\\", "/")).with_suffix(".json")).resolve()
+
+
+@attrs.frozen
+class SurrogateSettings:
+    """Where the samples are, what to fit, and where the fitted model is kept."""
+
+    model_file: Path
+    data_directory: Path
+    coordinates: tuple[str, ...]
+    epsilon: float = 1e-4
+    degree: int = 5
+    load: bool = False
+    save: bool = False
+    model_path: Path = Path("surrogateMuscles.json")
+    settings_file: Path | None = None
 
 
 def rotational_coordinates(model_file: str | os.PathLike[str]) -> set[str]:
@@ -90,23 +123,25 @@ def surrogate_from_settings(settings: SurrogateSettings) -> SurrogateModel:
     return model
 
 
-def accuracy_report(model: SurrogateModel) -> str:
-    """A table of each muscle's held-out accuracy (mm), worst muscle last line."""
-    lines = [f"{'muscle':<16s} {'coords':>6s} {'L rms':>8s} {'L max':>8s} {'r rms':>8s} {'r max':>8s}   (mm, held-out poses)"]
-    worst: tuple[float, str] | None = None
-    for m in model.muscles:
-        a = m.accuracy
-        if a is None:
-            lines.append(f"{m.muscle:<16s} {len(m.coordinates):>6d}   (no held-out poses)")
-            continue
-        lines.append(f"{m.muscle:<16s} {len(m.coordinates):>6d} {a.length_rms * 1e3:8.3f} {a.length_max * 1e3:8.3f} "
-                     f"{a.worst_moment_arm_rms * 1e3:8.3f} {a.worst_moment_arm_max * 1e3:8.3f}")
-        score = max(a.length_rms / 0.5e-3, a.worst_moment_arm_rms / 1e-3)
-        if worst is None or score > worst[0]:
-            worst = (score, m.muscle)
-    if model.excluded_muscles:
-        lines.append(f"not modeled (no moment arm > {model.epsilon:g} m): {', '.join(model.excluded_muscles)}")
-    if worst is not None:
-        lines.append(f"worst muscle: {worst[1]}")
-    return "\n".join(lines)
 
+_SURROGATE_CACHE: dict[tuple[Any, ...], SurrogateModel] = {}
+
+
+def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLike[str] | str,
+                   coordinates: Sequence[str], *, degree: int, epsilon: float, load: bool = False,
+                   save: bool = False, settings_file: os.PathLike[str] | str | None = None,
+                   file_name: str = DEFAULT_FILE_NAME) -> SurrogateModel:
+    """Fit (or load/save, as the settings ask) the surrogate of a muscle or synergy controller;
+    fits are cached per process (same data, coordinates, degree and epsilon). ``file_name``:
+    the settings' ``<surrogate_model_file_name>``, kept as JSON next to the settings file
+    (:func:`surrogate_model_path`)."""
+    key = (str(Path(model_file).resolve()), str(Path(data_directory).resolve()), tuple(coordinates), degree, epsilon)
+    if key in _SURROGATE_CACHE and not (load or save):
+        return _SURROGATE_CACHE[key]
+    settings = SurrogateSettings(model_file=Path(model_file), data_directory=Path(data_directory),
+                                 coordinates=tuple(coordinates), epsilon=epsilon, degree=degree, load=load, save=save,
+                                 model_path=surrogate_model_path(settings_file, file_name),
+                                 settings_file=Path(settings_file) if settings_file else None)
+    model = surrogate_from_settings(settings)
+    _SURROGATE_CACHE[key] = model
+    return model

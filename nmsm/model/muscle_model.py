@@ -1,4 +1,4 @@
-"""Muscle forces and joint moments for treatment controllers (spec tools.md §0.4, §8.3-2).
+"""Muscle forces and joint moments of the muscle and synergy controllers (spec tools.md §0.4, §8.3-2).
 
 Geometry comes from a fitted surrogate (:mod:`nmsm.model.surrogate`: lengths, velocities
 and moment arms as polynomials of the surrogate coordinates); forces from the rigid-tendon
@@ -17,48 +17,20 @@ replaced by CasADi expressions (Design Optimization model modifiers).
 
 from __future__ import annotations
 
-import os
-import warnings
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.core.row_map import map_rows
 from nmsm.errors import InputError
 from nmsm.io.osimx import OsimxModel, check_muscles_in_model
 from nmsm.model import hill
 from nmsm.model.surrogate import SurrogateModel
-from nmsm.tools.treatment.transcription.base import map_rows
 
 PARAMETERS = ("max_isometric_force", "optimal_fiber_length", "tendon_slack_length")
-
-_SURROGATE_CACHE: dict[tuple[Any, ...], SurrogateModel] = {}
-
-
-def load_surrogate(model_file: os.PathLike[str] | str, data_directory: os.PathLike[str] | str,
-                   coordinates: Sequence[str], *, degree: int, epsilon: float, load: bool = False,
-                   save: bool = False, settings_file: os.PathLike[str] | str | None = None,
-                   file_name: str = "surrogateMuscles.mat") -> SurrogateModel:
-    """Fit (or load/save, as the settings ask) the surrogate of the synergy controller;
-    fits are cached per process (same data, coordinates, degree and epsilon). ``file_name``:
-    the settings' ``<surrogate_model_file_name>``, kept as JSON next to the settings file
-    (extension replaced by ``.json``, :mod:`nmsm.tools.surrogate.settings`)."""
-    from nmsm.tools.surrogate.settings import SurrogateSettings, surrogate_model_path
-    from nmsm.tools.surrogate.tool import surrogate_from_settings
-
-    key = (str(Path(model_file).resolve()), str(Path(data_directory).resolve()), tuple(coordinates), degree, epsilon)
-    if key in _SURROGATE_CACHE and not (load or save):
-        return _SURROGATE_CACHE[key]
-    settings = SurrogateSettings(model_file=Path(model_file), data_directory=Path(data_directory),
-                                 coordinates=tuple(coordinates), epsilon=epsilon, degree=degree, load=load, save=save,
-                                 model_path=surrogate_model_path(settings_file, file_name),
-                                 settings_file=Path(settings_file) if settings_file else None)
-    model = surrogate_from_settings(settings)
-    _SURROGATE_CACHE[key] = model
-    return model
 
 
 @attrs.define
@@ -152,8 +124,3 @@ class MuscleModel:
         Qd = cs.horzcat(*[view.speed(c) for c in self.coordinates])
         return map_rows(self.point_function(), Q, Qd, activations, self.parameter_row(), parallel=parallel)
 
-
-def check_activation_range(values: np.ndarray, where: str) -> None:
-    """Warn when activations leave [0, 1] (synergy products can)."""
-    if values.size and (values.min() < -1e-6 or values.max() > 1 + 1e-6):
-        warnings.warn(f"{where}: activations span [{values.min():.3g}, {values.max():.3g}], outside [0, 1]", stacklevel=2)
