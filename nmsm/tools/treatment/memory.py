@@ -28,12 +28,12 @@ from nmsm.errors import InputError
 BASE_GB = 0.18
 FUNCTION_GB = 0.0131
 POINT_GB = 7.25e-5
-#: work of a state coordinate, a muscle and a contact spring, relative to a muscle (a state
-#: coordinate: its share of the inverse dynamics' SX instructions; a spring: what the
-#: full-body two-foot contact case needs at least, see docs/treatment.md "Scale")
+#: work of a state coordinate, a muscle and a contact spring, relative to a muscle: their
+#: shares of the per-point functions' SX instructions (a state coordinate in the inverse
+#: dynamics; a spring its force and its position and velocity on its foot body)
 STATE_WORK = 0.3
 MUSCLE_WORK = 1.0
-SPRING_WORK = 2.0
+SPRING_WORK = 0.25
 
 
 @attrs.frozen

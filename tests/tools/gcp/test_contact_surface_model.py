@@ -61,3 +61,52 @@ def test_matches_gcp_and_loads_are_consistent(synthetic_case):
         true_moment = np.cross((positions.T - point), per_spring.T).sum(axis=0)
         from_loads = sum(body_loads[6:9, i] + np.cross(body_loads[3:6, i] - point, body_loads[0:3, i]) for i in range(2))
         np.testing.assert_allclose(from_loads, true_moment, rtol=1e-10, atol=1e-8)
+
+
+def _surface(synthetic_case, copies: int = 1) -> OsimxContactSurface:
+    settings = GroundContactPersonalizationSettings.from_document(read_settings_document(synthetic_case.settings_file))
+    foot = load_feet(settings)[0][0]
+    truth = synthetic_case.truth
+    springs = tuple(GcpSpring(f"{n}_{c}", b, tuple(loc), float(kk)) for c in range(copies) for n, b, loc, kk in
+                    zip(foot.springs.names, foot.springs.bodies, foot.springs.locations, synthetic_case.spring_constants))
+    return OsimxContactSurface(
+        is_left_foot=False, belt_speed=truth.belt_speed, force_columns=("a", "b", "c"), moment_columns=("d", "e", "f"),
+        electrical_center_columns=("g", "h", "i"), hindfoot_body="calcn_r", toe_marker="R_Toe",
+        medial_marker="R_Toe_Medial", lateral_marker="R_Toe_Lateral", heel_marker="R_Heel",
+        midfoot_superior_marker="R_Midfoot_Superior", resting_spring_length=truth.resting_spring_length,
+        dynamic_friction_coefficient=truth.dynamic_friction_coefficient,
+        viscous_friction_coefficient=truth.viscous_friction_coefficient, damping_factor=truth.damping_factor,
+        latching_velocity=truth.latching_velocity, springs=springs)
+
+
+def test_spring_kinematics_equal_each_point_on_its_body(synthetic_case) -> None:
+    model = load_model(synthetic_case.model_file)
+    contact = ContactSurfaceModel.from_osimx(_surface(synthetic_case), model)
+    cm = CasadiModel(model)
+    rng = np.random.default_rng(1)
+    q, qd = rng.normal(0.0, 0.3, cm.n), rng.normal(0.0, 1.0, cm.n)
+    positions, velocities = (np.array(v) for v in contact.spring_kinematics_function(cm)(q, qd))
+    for j, (body, location) in enumerate(zip(contact.spring_bodies, contact.spring_locations)):
+        np.testing.assert_allclose(np.array(cm.point_function(body)(q, location)).ravel(), positions[:, j],
+                                   rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(np.array(cm.point_velocity_function(body)(q, qd, location)).ravel(),
+                                   velocities[:, j], rtol=1e-12, atol=1e-14)
+
+
+def test_a_spring_adds_a_few_operations_not_a_kinematic_chain(synthetic_case, tutorial) -> None:
+    """Each foot body's pose and motion are computed once for all its springs: on the GCP
+    tutorial's full-body model a spring's position and velocity cost a few dozen SX
+    operations (rotation of its location, cross product with the angular velocity), where
+    the kinematic chain from the ground to the toes costs hundreds."""
+    model = load_model(tutorial / "bodyModel.osim")
+    cm = CasadiModel(model)
+    one = ContactSurfaceModel.from_osimx(_surface(synthetic_case, 1), model)
+    two = ContactSurfaceModel.from_osimx(_surface(synthetic_case, 2), model)
+    q, qd = cs.SX.sym("q", cm.n), cs.SX.sym("qd", cm.n)  # new symbols, as a contact model's point function has
+
+    def size(contact: ContactSurfaceModel) -> int:
+        return cs.Function("springs", [q, qd], list(contact.spring_kinematics(cm, q, qd))).n_instructions()
+
+    per_spring = (size(two) - size(one)) / one.n_springs
+    chain = cm.point_function("toes_r").n_instructions()
+    assert per_spring < 60 and chain > 500, (per_spring, chain)
