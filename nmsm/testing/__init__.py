@@ -38,16 +38,27 @@ Then, on a small synthetic problem of the tool (built in code, no files of the u
 ``unknown names refused``  a name element (``<coordinate>``, ``<marker>``, ...) naming what the
                            problem has not is refused with an InputError quoting the name.
 
-The synthetic problems: Treatment Optimization (TO, VO, DO): a two-link pendulum with a coupled
-coordinate; coordinates ``q0``, ``q1``, ``follower``, markers ``tip_0``, ``tip_1``,
-``follower_marker``, bodies ``link_0``, ``link_1``, torque controls ``q0_moment``,
-``q1_moment``; states at the tracked motion (:mod:`nmsm.testing.pendulum_problem`). MTP, SynX,
-MTLI, NCP, GCP, JMP: :mod:`nmsm.testing.synthetic_problems` (muscles, synergy groups, a foot,
-a leg). A treatment term that needs what the pendulum has not (muscles, contact, synergies, a
-metabolic model) is reported as not built (``report.not_built`` says why); its declaration
-and settings checks still run. A treatment term that differentiates a quantity depending on
-the controls gets a :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning`, recorded in
-``report.warnings``.
+The synthetic problems: Treatment Optimization (TO, VO, DO): a term is built on the first of
+these whose context its ``bind`` accepts (``report.problem`` names it):
+
+* ``pendulum``: a two-link pendulum with a coupled coordinate; coordinates ``q0``, ``q1``,
+  ``follower``, markers ``tip_0``, ``tip_1``, ``follower_marker``, bodies ``link_0``,
+  ``link_1``, torque controls ``q0_moment``, ``q1_moment``; states at the tracked motion
+  (:mod:`nmsm.testing.pendulum_problem`);
+* ``leg``: a planar leg on the pendulum's names (hip ``q0``, knee ``q1``, bodies ``link_0``,
+  ``link_1``, markers ``tip_0``, ``tip_1``, torque control ``q0_moment``) with an ankle
+  ``q2``, toes ``q3``, a two-segment foot (hindfoot ``calcn``, ``toes``) on an
+  elastic-foundation contact surface (ground-reaction columns ``ground_force_v[xyz]``,
+  ``ground_torque_[xyz]``), muscles ``muscle_0``..``muscle_2`` driven by the synergies
+  ``group_1``, ``group_2`` of synergy group ``group`` (vectors optimized except in VO,
+  surrogate fitted to the leg's own path geometry); its tracked ground reactions and muscle
+  activations are the model's at the start (:mod:`nmsm.testing.leg_problem`).
+
+MTP, SynX, MTLI, NCP, GCP, JMP: :mod:`nmsm.testing.synthetic_problems` (muscles, synergy groups,
+a foot, a leg). A term refused by every problem of its tool is reported as not built
+(``report.not_built`` gives each problem's reason); its declaration and settings checks still
+run. A treatment term that differentiates a quantity depending on the controls gets a
+:class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning`, recorded in ``report.warnings``.
 """
 
 from __future__ import annotations
@@ -72,7 +83,8 @@ from nmsm.core.term import (
 from nmsm.errors import InputError, NmsmError
 from nmsm.testing.synthetic_problems import BUILDERS, ZERO_AT_TRACKED, SyntheticProblem
 
-#: Values of required fields on the synthetic pendulum, used when the example does not give them.
+#: Values of fields on the synthetic pendulum (and the leg, which has these names too), used
+#: when the example does not give them.
 PENDULUM_VALUES: dict[str, str] = {
     "coordinate": "q0",
     "load": "q0_moment",
@@ -82,8 +94,8 @@ PENDULUM_VALUES: dict[str, str] = {
     "controller": "q0_moment",
 }
 
-#: Names the pendulum has not (muscles, contact, synergies, user functions), used for required
-#: fields the example does not give: the settings checks run, and building reports why not.
+#: Names of the synthetic leg the pendulum has not (muscles, contact, synergies), and a user
+#: function no problem has, used for required fields the example does not give.
 PLACEHOLDER_VALUES: dict[str, str] = {
     "muscle": "muscle_0",
     "hindfoot_body": "calcn",

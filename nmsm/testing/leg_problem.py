@@ -102,11 +102,10 @@ def _vec(values: Sequence[float]) -> str:
 
 def _planar_point(q: np.ndarray, body: str, location: Sequence[float]) -> np.ndarray:
     """(x, y) in ground of a point of ``body`` at pose ``q`` (4,) (rad): the planar chain."""
-    chain = [j for j in JOINTS]
     path = []
     current = body
     while current != "ground":
-        joint = next(j for j in chain if j[2] == current)
+        joint = next(j for j in JOINTS if j[2] == current)
         path.append(joint)
         current = joint[1]
     point = np.asarray(location[:2], dtype=float)
@@ -236,25 +235,6 @@ class LegCase:
     weights: Any
 
 
-def _mesh() -> Any:
-    from nmsm.tools.treatment.transcription.mesh import Mesh
-
-    return Mesh.uniform(3, 3)
-
-
-def _setup(tool: str, case_model: Any, folder: Path, references: dict[str, Any],
-           initial_guess: dict[str, Any], weights: Any) -> Any:
-    from nmsm.core.controller_setup import ControllerSetup
-
-    mesh = _mesh()
-    setup = ControllerSetup(tool, case_model, mesh.times("collocation") * DURATION, DURATION, references,
-                            initial_guess, model_file=folder / "leg.osim", osimx=folder / "leg.osimx",
-                            trial_name=TRIAL, save_files=False, settings_file=folder / "check_term.xml")
-    setup.node_times = mesh.times("nodes") * DURATION
-    setup.extras["files"] = _Files(weights)
-    return setup
-
-
 @attrs.frozen
 class _Files:
     """The initial-guess files the synergy controller reads (its ``synergyWeights.sto``)."""
@@ -262,10 +242,10 @@ class _Files:
     synergy_weights: Any
 
 
-def _contacts(tool: str, setup: Any) -> list[Any]:
-    from nmsm.core.registry import get_registry
+def _mesh() -> Any:
+    from nmsm.tools.treatment.transcription.mesh import Mesh
 
-    return [c for item in get_registry().items("contact", tool) for c in item.cls.discover(setup)]
+    return Mesh.uniform(3, 3)
 
 
 @functools.cache
@@ -290,46 +270,60 @@ def leg_case() -> LegCase:
     initial_guess = {"synergyCommands": ReferenceSplines(t, SYNERGIES, commands), "loads": loads}
     references = {"coordinates": coordinates, "loads": loads,
                   "activations": ReferenceSplines(t, tuple(MUSCLES), commands @ WEIGHTS)}
-    setup = _setup("TO", model, folder, references, initial_guess, weights)
-    (contact,) = _contacts("TO", setup)
-    f = contact.point_function(model)
-    p = cs.evalf(contact.parameters()).T
-    q, qd = coordinates.values(t, 0), coordinates.values(t, 1)
-    _, force, moment, point = (np.asarray(v).T for v in f.map(t.size)(q.T, qd.T, cs.repmat(p, 1, t.size)))
-    floor = point * np.array([1.0, 0.0, 1.0])
-    references["ground_reactions"] = ReferenceSplines(
-        t, GRF_COLUMNS["force"] + GRF_COLUMNS["moment"] + GRF_COLUMNS["center"], np.hstack([force, moment, floor]))
-    return LegCase(folder, model, mesh, references, initial_guess, weights)
+    case = LegCase(folder, model, mesh, references, initial_guess, weights)
+    references["ground_reactions"] = ReferenceSplines(t, sum(GRF_COLUMNS.values(), ()), _ground_reactions(case))
+    return case
 
 
-def build_leg_problem(terms: Sequence[Any], *, tool: str = "TO") -> Any:
-    """The problem of the module docstring with ``terms`` (a
-    :class:`~nmsm.tools.treatment.formulation.TreatmentProblem`)."""
+def _ground_reactions(case: LegCase) -> np.ndarray:
+    """(nodes, 9) the contact surface's force (N), moment about the midfoot marker's floor
+    point (N·m) and that point (m) on the mesh nodes of the tracked motion (the start)."""
+    built = _build(case, "TO", [])
+    nodes = built.context.at("nodes")
+    columns = [nodes.ground_reaction_force(c) for c in GRF_COLUMNS["force"]]
+    columns += [nodes.ground_reaction_moment(c) for c in GRF_COLUMNS["moment"]]
+    columns.append(nodes.foot_ground_reaction("calcn")[2])
+    problem = built.problem
+    return np.asarray(problem.evaluate(cs.horzcat(*columns), problem.initial_scaled()))
+
+
+def _build(case: LegCase, tool: str, terms: Sequence[Any]) -> Any:
     from nmsm.core.bounds import RangeRule, range_bounds
+    from nmsm.core.controller_setup import ControllerSetup
     from nmsm.core.registry import get_registry
     from nmsm.tools.treatment.formulation import StateSetup, build_problem
     from nmsm.tools.treatment.problem_data import TreatmentData
 
-    case = leg_case()
-    setup = _setup(tool, case.model, case.folder, case.references, case.initial_guess, case.weights)
+    mesh = case.mesh
+    setup = ControllerSetup(tool, case.model, mesh.times("collocation") * DURATION, DURATION, case.references,
+                            case.initial_guess, model_file=case.folder / "leg.osim", osimx=case.folder / "leg.osimx",
+                            trial_name=TRIAL, save_files=False, settings_file=case.folder / "check_term.xml")
+    setup.node_times = mesh.times("nodes") * DURATION
+    setup.extras["files"] = _Files(case.weights)
     registry = get_registry()
     torque = registry.get("controller", "torque", tool).from_settings({"coordinate_list": "q0"}, setup)
     synergy = registry.get("controller", "synergy", tool).from_settings(
         {"surrogate_model_coordinate_list": "q1 q2", "surrogate_model_data_directory": str(case.folder / "surrogate"),
          "surrogate_model_polynomial_degree": 3, "optimize_synergy_vectors": tool != "VO"}, setup)
+    contacts = [c for item in registry.items("contact", tool) for c in item.cls.discover(setup)]
     coordinates = case.references["coordinates"]
     data = TreatmentData(tool, case.model, STATES, case.references, coordinates, DURATION, DURATION,
-                         (DURATION, DURATION), controllers=[torque, synergy], contact_models=_contacts(tool, setup))
+                         (DURATION, DURATION), controllers=[torque, synergy], contact_models=contacts)
     t = coordinates.time
     lo_q, hi_q = range_bounds(coordinates.values(t, 0, STATES), RangeRule(2))
     lo_v, hi_v = range_bounds(coordinates.values(t, 1, STATES), RangeRule(1.5))
     lo_a, hi_a = range_bounds(coordinates.values(t, 2, STATES), RangeRule(1))
-    mesh = case.mesh
     tn = mesh.times("nodes") * DURATION
     guess = np.hstack([coordinates.values(tn, 0, STATES), coordinates.values(tn, 1, STATES)])
     states = StateSetup(np.r_[lo_q, lo_v], np.r_[hi_q, hi_v], lo_a, hi_a, guess,
                         coordinates.values(mesh.times("collocation") * DURATION, 2, STATES))
     return build_problem(data, mesh, states, list(terms))
+
+
+def build_leg_problem(terms: Sequence[Any], *, tool: str = "TO") -> Any:
+    """The problem of the module docstring with ``terms`` (a
+    :class:`~nmsm.tools.treatment.formulation.TreatmentProblem`)."""
+    return _build(leg_case(), tool, terms)
 
 
 __all__ = ["COORDINATES", "DURATION", "GRF_COLUMNS", "MUSCLES", "SYNERGIES", "LegCase", "build_leg_problem",
