@@ -10,20 +10,22 @@ Written in code into a temporary folder (removed at exit), once per process:
   foot markers ``heel``, ``toe``, ``midfoot``; three path-point muscles
   (:data:`MUSCLES`) in the ForceSet group ``group``;
 * ``leg.osimx``: the synergy group ``group`` with two synergies (``group_1``, ``group_2``)
-  and an elastic-foundation contact surface on ``calcn`` (:data:`SPRINGS`, treadmill belt
-  at 0.2 m/s, slower than the foot's swing, so the forward force changes sign) whose ground-reaction columns are ``ground_force_v[xyz]``,
-  ``ground_torque_[xyz]`` and ``ground_force_p[xyz]``;
+  and an elastic-foundation contact surface on ``calcn`` (:data:`SPRINGS`; treadmill belt at
+  0.2 m/s, slower than the foot's swing, so the forward force changes sign) whose
+  ground-reaction columns are ``ground_force_v[xyz]``, ``ground_torque_[xyz]`` and
+  ``ground_force_p[xyz]``;
 * ``surrogate/``: the muscles' exact path geometry (:func:`nmsm.model.muscle_analysis.analyze_motion`)
   on a grid of knee and ankle poses, from which the synergy controller fits its surrogate.
 
 The problem (:func:`build_leg_problem`): states ``q0``..``q3`` over 1 s, 3 mesh intervals of
 3 collocation points, starting on the tracked motion (:func:`motion`); a torque control on
 ``q0`` (``q0_moment``) and the synergy controller on ``q1``, ``q2`` (its synergy vectors
-optimized, except in VO). The tracked data are the model's own on the tracked motion, sampled
-on the mesh nodes: ground reactions of the contact surface (free torques written about the
-midfoot marker's floor point, the centre of pressure of the model's), activations ``C W`` of
-the starting synergy commands ``C`` and vectors ``W``. A tracking term of these is zero at the
-start.
+optimized, except in VO; its surrogate of degree 3). The tracked data are the model's own on
+the tracked motion, sampled on the mesh nodes, where their splines interpolate exactly: ground
+reactions of the contact surface (torques about the midfoot marker's floor point, which stands
+for the electrical centre, so the tracked centre of pressure is the model's), activations
+``C W`` of the starting synergy commands ``C`` and vectors ``W``. A tracking term of these is
+zero at the start.
 """
 
 from __future__ import annotations

@@ -131,3 +131,23 @@ def test_the_leg_reproduces_its_tracked_ground_reactions_and_activations() -> No
     a_exp = np.column_stack([np.asarray(ctx.tracked_muscle_activation(m)).ravel() for m in ctx.muscle_names])
     np.testing.assert_allclose(a, a_exp, rtol=1e-9, atol=1e-12)
     assert 0.05 < a.min() and a.max() < 0.5
+
+
+@pytest.mark.parametrize("name, kind, tool", [
+    ("muscle_activation_deviation", "constraint", "VO"),  # synergy vectors fixed in VO
+    ("muscle_activation_tracking", "cost", "TO"),
+    ("external_moment_tracking", "cost", "TO"),
+    ("synergy_vector_sum", "constraint", "TO"),
+])
+def test_leg_terms_are_built_for_each_of_their_tools(name: str, kind: str, tool: str) -> None:
+    from nmsm.core.registry import get_registry
+
+    report = check_term(get_registry().get(kind, name, tool), tool=tool)
+    assert report.problem == "leg" and report.not_built is None and "derivatives" in report.passed
+
+
+def test_the_legs_synergy_vectors_are_optimized_except_in_verification() -> None:
+    from nmsm.testing.leg_problem import build_leg_problem
+
+    assert {tool: "synergy_weights" in build_leg_problem([], tool=tool).problem.variables
+            for tool in ("TO", "VO", "DO")} == {"TO": True, "VO": False, "DO": True}
