@@ -117,6 +117,14 @@ class _SizeTracking(_Tracking):
 
 
 @attrs.frozen(kw_only=True)
+class _NonFinite(_Tracking):
+    """The square root of a negative number (NaN)."""
+
+    def quantity(self, ctx: Any) -> Any:
+        return cs.sqrt(-1 - super().quantity(ctx) ** 2)
+
+
+@attrs.frozen(kw_only=True)
 class _MisspelledQuantity(_Tracking):
     """Asks the context for a quantity it has not."""
 
@@ -162,6 +170,7 @@ class _AcceptsZeroError(_Tracking):
     (_OffsetTracking, "not zero on the tracked motion"),
     (_HiddenDerivative, "differs from finite differences"),
     (_SizeTracking, r"\(K, 1\)|column|shape"),
+    (_NonFinite, "non-finite values"),
     (_MisspelledQuantity, "coordinat"),
     (_TrackingWithoutNameCheck, "check_term_no_such_coordinate.*not refused with an InputError"),
     (_DataOnly, "does not depend on any design variable"),

@@ -95,6 +95,7 @@ def _broken(base: type, quantity: Any, bind: Any = None) -> type:
     (_broken(_ActivationTracking, lambda t, ctx, q: _half_derivative(q)), "differs from finite differences"),
     (_broken(_MetabolicEnergy, lambda t, ctx, q: _half_derivative(q)), "differs from finite differences"),
     (_broken(_ForceTracking, lambda t, ctx, q: cs.sum1(q)), r"\(K, 1\)|column|shape"),
+    (_broken(_ActivationTracking, lambda t, ctx, q: cs.sqrt(-1 - q**2)), "non-finite values"),
     (_broken(_ForceTracking, lambda t, ctx, q: cs.MX(ctx.tracked_ground_reaction_force(t.force))),
      "does not depend on any design variable"),
     (_broken(_MetabolicEnergy, lambda t, ctx, q: ctx.metabolic_rat()), "metabolic_rat"),
@@ -151,3 +152,19 @@ def test_the_legs_synergy_vectors_are_optimized_except_in_verification() -> None
 
     assert {tool: "synergy_weights" in build_leg_problem([], tool=tool).problem.variables
             for tool in ("TO", "VO", "DO")} == {"TO": True, "VO": False, "DO": True}
+
+
+def test_plugins_check_says_where_each_term_was_built(capsys: pytest.CaptureFixture[str]) -> None:
+    import warnings
+
+    from nmsm.commands import _check_terms
+    from nmsm.core.registry import get_registry
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        items = [it for it in get_registry().items() if it.name in ("external_force_tracking", "generalized_speed_tracking")]
+    assert _check_terms(items) == 0
+    lines = sorted(line for line in capsys.readouterr().out.splitlines() if line.startswith("ok"))
+    assert [line.split(":")[0] for line in lines] == ["ok      cost external_force_tracking",
+                                                      "ok      cost generalized_speed_tracking"]
+    assert lines[0].endswith("(on leg)") and lines[1].endswith("(on pendulum)")
