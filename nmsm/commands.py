@@ -69,7 +69,7 @@ def _check_terms(items: Any) -> int:
             failed += 1
             print(f"FAILED  {it.kind} {it.name}: {exc}")
             continue
-        extra = f" (not built: {result.not_built})" if result.not_built else ""
+        extra = f" (not built: {result.not_built})" if result.not_built else f" (on {result.problem})"
         extra += "".join(f"\n        warning: {w}" for w in result.warnings)
         print(f"ok      {it.kind} {it.name}: {', '.join(result.passed)}{extra}")
     print(f"\n{len(seen) - failed} of {len(seen)} term classes pass nmsm.testing.check_term")

@@ -38,16 +38,27 @@ Then, on a small synthetic problem of the tool (built in code, no files of the u
 ``unknown names refused``  a name element (``<coordinate>``, ``<marker>``, ...) naming what the
                            problem has not is refused with an InputError quoting the name.
 
-The synthetic problems: Treatment Optimization (TO, VO, DO): a two-link pendulum with a coupled
-coordinate; coordinates ``q0``, ``q1``, ``follower``, markers ``tip_0``, ``tip_1``,
-``follower_marker``, bodies ``link_0``, ``link_1``, torque controls ``q0_moment``,
-``q1_moment``; states at the tracked motion (:mod:`nmsm.testing.pendulum_problem`). MTP, SynX,
-MTLI, NCP, GCP, JMP: :mod:`nmsm.testing.synthetic_problems` (muscles, synergy groups, a foot,
-a leg). A treatment term that needs what the pendulum has not (muscles, contact, synergies, a
-metabolic model) is reported as not built (``report.not_built`` says why); its declaration
-and settings checks still run. A treatment term that differentiates a quantity depending on
-the controls gets a :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning`, recorded in
-``report.warnings``.
+The synthetic problems: Treatment Optimization (TO, VO, DO): a term is built on the first of
+these whose context its ``bind`` accepts (``report.problem`` names it):
+
+* ``pendulum``: a two-link pendulum with a coupled coordinate; coordinates ``q0``, ``q1``,
+  ``follower``, markers ``tip_0``, ``tip_1``, ``follower_marker``, bodies ``link_0``,
+  ``link_1``, torque controls ``q0_moment``, ``q1_moment``; states at the tracked motion
+  (:mod:`nmsm.testing.pendulum_problem`);
+* ``leg``: a planar leg on the pendulum's names (hip ``q0``, knee ``q1``, bodies ``link_0``,
+  ``link_1``, markers ``tip_0``, ``tip_1``, torque control ``q0_moment``) with an ankle
+  ``q2``, toes ``q3``, a two-segment foot (hindfoot ``calcn``, ``toes``) on an
+  elastic-foundation contact surface (ground-reaction columns ``ground_force_v[xyz]``,
+  ``ground_torque_[xyz]``), muscles ``muscle_0``..``muscle_2`` driven by the synergies
+  ``group_1``, ``group_2`` of synergy group ``group`` (vectors optimized except in VO,
+  surrogate fitted to the leg's own path geometry); its tracked ground reactions and muscle
+  activations are the model's at the start (:mod:`nmsm.testing.leg_problem`).
+
+MTP, SynX, MTLI, NCP, GCP, JMP: :mod:`nmsm.testing.synthetic_problems` (muscles, synergy groups,
+a foot, a leg). A term refused by every problem of its tool is reported as not built
+(``report.not_built`` gives each problem's reason); its declaration and settings checks still
+run. A treatment term that differentiates a quantity depending on the controls gets a
+:class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning`, recorded in ``report.warnings``.
 """
 
 from __future__ import annotations
@@ -72,7 +83,8 @@ from nmsm.core.term import (
 from nmsm.errors import InputError, NmsmError
 from nmsm.testing.synthetic_problems import BUILDERS, ZERO_AT_TRACKED, SyntheticProblem
 
-#: Values of required fields on the synthetic pendulum, used when the example does not give them.
+#: Values of fields on the synthetic pendulum (and the leg, which has these names too), used
+#: when the example does not give them.
 PENDULUM_VALUES: dict[str, str] = {
     "coordinate": "q0",
     "load": "q0_moment",
@@ -82,11 +94,11 @@ PENDULUM_VALUES: dict[str, str] = {
     "controller": "q0_moment",
 }
 
-#: Names the pendulum has not (muscles, contact, synergies, user functions), used for required
-#: fields the example does not give: the settings checks run, and building reports why not.
+#: Names of the synthetic leg the pendulum has not (muscles, contact, synergies), and a user
+#: function no problem has, used for required fields the example does not give.
 PLACEHOLDER_VALUES: dict[str, str] = {
     "muscle": "muscle_0",
-    "hindfoot_body": "link_0",
+    "hindfoot_body": "calcn",
     "force": "ground_force_vx",
     "moment": "ground_torque_z",
     "synergy": "group_1",
@@ -96,11 +108,13 @@ PLACEHOLDER_VALUES: dict[str, str] = {
 
 #: Families whose ``*_tracking`` treatment cost is zero on the tracked motion.
 _ZERO_AT_TRACKING = ("generalized_coordinate", "generalized_speed", "marker_position", "marker_velocity",
-                     "body_orientation")
+                     "body_orientation", "external_force", "external_moment", "center_of_pressure",
+                     "center_of_presssure", "muscle_activation")
 
 #: Fields naming a part of the model or data; :func:`check_term` sets each to a name the
 #: synthetic problem has not and expects an InputError quoting it.
-NAME_FIELDS = ("coordinate", "load", "marker", "body", "controller", "muscle", "hindfoot_body", "synergy")
+NAME_FIELDS = ("coordinate", "load", "marker", "body", "controller", "muscle", "hindfoot_body", "synergy", "force",
+               "moment")
 
 
 class TermCheckError(AssertionError):
@@ -110,13 +124,16 @@ class TermCheckError(AssertionError):
 @attrs.define
 class TermCheckReport:
     """What :func:`check_term` checked: ``passed`` (names of checks), ``not_built`` (why the
-    term was not built on the synthetic problem, or None) and ``warnings`` (messages of
-    :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning` while building)."""
+    term was not built on the synthetic problem, or None), ``warnings`` (messages of
+    :class:`~nmsm.core.ocp.DiscontinuousDerivativeWarning` while building) and ``problem``
+    (the synthetic problem it was built on: the tool's code, or for TO, VO and DO
+    ``"pendulum"`` or ``"leg"``)."""
 
     cls: type
     passed: list[str] = attrs.field(factory=list)
     not_built: str | None = None
     warnings: list[str] = attrs.field(factory=list)
+    problem: str | None = None
 
 
 def check_term(cls: type, example: Mapping[str, str] | None = None, *, tool: str | None = None,
@@ -236,35 +253,67 @@ def _pendulum_problem(tool: str) -> SyntheticProblem:
     """The pendulum problem; tracked point: the states on the tracked motion."""
     from nmsm.testing.pendulum_problem import build_pendulum_problem
 
-    built = build_pendulum_problem([], tool=tool)
+    return _treatment_problem(build_pendulum_problem([], tool=tool))
+
+
+def _leg_problem(tool: str) -> SyntheticProblem:
+    """The leg problem (muscles, synergies, foot contact); tracked point: its start."""
+    from nmsm.testing.leg_problem import build_leg_problem
+
+    return _treatment_problem(build_leg_problem([], tool=tool))
+
+
+def _treatment_problem(built: Any) -> SyntheticProblem:
+    """Its tracked point is set once the term is added (:func:`_start`): terms may add variables."""
+    return SyntheticProblem(built.problem, built.context, None)
+
+
+def _start(built: SyntheticProblem) -> np.ndarray:
+    """The treatment problem's starting point within its bounds (the tracked motion)."""
     lower, upper = built.problem.bounds_scaled()
-    return SyntheticProblem(built.problem, built.context, np.clip(built.problem.initial_scaled(), lower, upper))
+    return np.clip(built.problem.initial_scaled(), lower, upper)
+
+
+#: the synthetic treatment problems, tried in this order: a term is built on the first whose
+#: context its ``bind`` accepts
+TREATMENT_PROBLEMS: tuple[tuple[str, Any], ...] = (("pendulum", _pendulum_problem), ("leg", _leg_problem))
 
 
 def _build(name: str, term: Term, tool: str, report: TermCheckReport) -> SyntheticProblem | None:
     """The tool's synthetic problem with the term added; None (``report.not_built`` says why)
-    when binding the term raised an InputError (it needs what the problem has not)."""
-    built = _pendulum_problem(tool) if tool in TREATMENT_TOOLS else BUILDERS[tool](tool)
+    when binding the term raised an InputError on every synthetic problem of the tool (it needs
+    what they have not). ``report.problem`` names the problem it was built on."""
+    candidates = TREATMENT_PROBLEMS if tool in TREATMENT_TOOLS else ((tool, BUILDERS[tool]),)
+    refusals = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", DiscontinuousDerivativeWarning)
-        try:
-            term.bind(built.context)
-        except InputError as exc:  # the term needs what the synthetic problem has not (bind said so)
-            report.not_built = str(exc)
+        for label, builder in candidates:
+            built = builder(tool)
+            try:
+                term.bind(built.context)
+            except InputError as exc:  # the term needs what this synthetic problem has not (bind said so)
+                refusals.append(f"{label}: {exc}" if len(candidates) > 1 else str(exc))
+                continue
+            except NmsmError as exc:
+                raise TermCheckError(f"{name}: bind failed on the synthetic {tool} problem ({label}): {exc}") from exc
+            break
+        else:
+            report.not_built = "; ".join(refusals)
             return None
-        except NmsmError as exc:
-            raise TermCheckError(f"{name}: bind failed on the synthetic {tool} problem: {exc}") from exc
+        report.problem = label
         try:
             form = built.form_problem(term) if built.form_problem is not None else None
             if form is None:
                 built.add_term(term)
         except NmsmError as exc:  # bound, but its quantity does not build (shape, a missing quantity, ...)
-            raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: {exc}") from exc
+            raise TermCheckError(f"{name}: building on the synthetic {tool} problem ({label}) failed: {exc}") from exc
         except Exception as exc:  # the tool's reduction refused the quantity's form
-            raise TermCheckError(f"{name}: building on the synthetic {tool} problem failed: "
+            raise TermCheckError(f"{name}: building on the synthetic {tool} problem ({label}) failed: "
                                  f"{type(exc).__name__}: {exc}") from exc
     if form is not None:
         raise TermCheckError(f"{name}: on the synthetic {tool} problem the {form}")
+    if tool in TREATMENT_TOOLS:
+        built.tracked = _start(built)
     for warning in caught:
         if issubclass(warning.category, DiscontinuousDerivativeWarning):
             report.warnings.append(str(warning.message))

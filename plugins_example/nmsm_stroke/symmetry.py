@@ -41,7 +41,7 @@ class SynergyAmplitudeSymmetry(DiscreteCost):
 
     type: ClassVar[str] = "synergy_amplitude_symmetry"
     tools: ClassVar[frozenset[str]] = frozenset({"TO", "DO"})
-    check_example: ClassVar[dict[str, str]] = {"synergy_pairs": "RightSynergies_1:LeftSynergies_1"}
+    check_example: ClassVar[dict[str, str]] = {"synergy_pairs": "group_1:group_2"}  # check_term's leg
     synergy_pairs: str
     amplitude: str = "rms"
     #: set by from_spec: one term per pair

@@ -9,6 +9,7 @@ of :mod:`nmsm.terms.treatment.center_of_pressure`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import attrs
@@ -21,6 +22,8 @@ from nmsm.core.ocp import PathConstraint
 @attrs.frozen(kw_only=True)
 class _CenterOfPressurePath(PathConstraint):
     tools: ClassVar[frozenset[str]] = frozenset({"TO", "DO"})
+    #: the leg of nmsm.testing.check_term: its foot stands on the belt the whole movement
+    check_example: ClassVar[Mapping[str, str]] = {"time_ranges": "0 1", "axis": "x"}
     deviation: ClassVar[bool] = False
     hindfoot_body: str
     axis: str | None = None

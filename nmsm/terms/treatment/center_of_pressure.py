@@ -13,6 +13,7 @@ by ``max(|CoP_exp|, min_reference_value)``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import attrs
@@ -41,6 +42,8 @@ class CenterOfPressureTracking(ContinuousCost):
 
     type: ClassVar[str] = "center_of_pressure_tracking"
     tools: ClassVar[frozenset[str]] = frozenset({"TO", "DO"})
+    #: the leg of nmsm.testing.check_term: its foot stands on the belt the whole movement
+    check_example: ClassVar[Mapping[str, str]] = {"time_ranges": "0 1", "axis": "x"}
     hindfoot_body: str
     axis: str | None = None
     use_relative_error: bool = False

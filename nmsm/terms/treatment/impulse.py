@@ -11,6 +11,7 @@ required. ``normalize_by_final_time`` (default false) divides by ``t_f``: the me
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import attrs
@@ -23,6 +24,8 @@ from nmsm.core.ocp import DiscreteCost
 class _ImpulseGoal(DiscreteCost):
     tools: ClassVar[frozenset[str]] = frozenset({"DO"})
     sign: ClassVar[float] = 1.0
+    #: a target for nmsm.testing.check_term (its leg's foot is pushed backwards by the belt)
+    check_example: ClassVar[Mapping[str, str]] = {"error_center": "100"}
     hindfoot_body: str
     error_center: float | None = None  # required (checked in bind)
     normalize_by_final_time: bool = False
