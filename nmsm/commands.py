@@ -107,7 +107,7 @@ def register(subparsers: Any) -> None:
 
     p = subparsers.add_parser(
         "plugins",
-        help="list every registered term, constraint, controller, modifier and contact model, and broken plugins",
+        help="list every registered term, constraint, controller, modifier, contact model and back end, and broken plugins",
     )
     p.add_argument("--kind", choices=list(KINDS), help="only this kind")
     p.add_argument("--check", action="store_true",

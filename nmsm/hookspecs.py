@@ -2,8 +2,9 @@
 
 A plugin is a module named by an entry point in the ``nmsm`` group. It implements one
 or more of these hooks with :data:`hookimpl`; each hook returns a list of classes.
-The built-in terms, constraints, controllers and modifiers are registered through
-these very hooks (see ``[project.entry-points.nmsm]`` in nmsm's ``pyproject.toml``).
+The built-in terms, constraints, controllers, modifiers and back ends are registered through
+these very hooks (see ``[project.entry-points.nmsm]`` in nmsm's ``pyproject.toml``, the same
+as :data:`BUILTIN_PLUGINS`).
 
 Example plugin module::
 
@@ -38,6 +39,15 @@ import pluggy
 PROJECT_NAME = "nmsm"
 ENTRY_POINT_GROUP = "nmsm"
 
+#: nmsm's own plugin modules, by entry-point name (``[project.entry-points.nmsm]`` of pyproject.toml)
+BUILTIN_PLUGINS: dict[str, str] = {
+    "builtin_terms": "nmsm.terms",
+    "builtin_constraints": "nmsm.constraints",
+    "builtin_controllers": "nmsm.controllers",
+    "builtin_modifiers": "nmsm.modifiers",
+    "builtin_backends": "nmsm.core.backends.builtin",
+}
+
 hookspec = pluggy.HookspecMarker(PROJECT_NAME)
 hookimpl = pluggy.HookimplMarker(PROJECT_NAME)
 
@@ -64,3 +74,8 @@ class NmsmHookSpecs:
     @hookspec
     def nmsm_model_modifiers(self) -> list[type]:
         """Return :class:`nmsm.core.plugin_bases.ModelModifier` subclasses (Design Optimization ``model_functions``)."""
+
+    @hookspec
+    def nmsm_backends(self) -> list[type]:
+        """Return :class:`nmsm.core.backends.Backend` subclasses (solvers chosen by name:
+        ``problem.solve("name")``)."""

@@ -2,7 +2,8 @@
 
 A tool declares design variables (bounds, scaling, initial values), static parameters,
 cost residuals (usually from registered :class:`~nmsm.core.term.CostTerm` objects) and
-constraints, all as CasADi MX expressions. The same problem is handed to a back end:
+constraints, all as CasADi MX expressions. The same problem is handed to a back end
+registered by name (:mod:`nmsm.core.backends`), e.g.:
 
 * ``least_squares`` - scipy ``least_squares`` with exact CasADi Jacobians (bounds only);
 * ``ipopt``         - CasADi ``nlpsol`` with IPOPT, exact first and second derivatives.
@@ -284,7 +285,8 @@ class OptimizationProblem:
 
     # ---- solving ------------------------------------------------------------------------
     def solve(self, backend: str = "ipopt", **options: Any) -> Solution:
-        """Solve with ``backend`` ('least_squares' or 'ipopt'); options go to the back end."""
-        from nmsm.core.backends import get_backend
+        """Solve with the back end registered as ``backend`` (``ipopt``, ``least_squares``, ...:
+        ``nmsm plugins --kind backend``); options go to the back end."""
+        from nmsm.core.backends.base import get_backend
 
-        return get_backend(backend)(self, **options)
+        return get_backend(backend).solve(self, **options)

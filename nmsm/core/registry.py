@@ -1,4 +1,5 @@
-"""Plugin registry: every term, constraint, controller and model modifier, by kind and name.
+"""Plugin registry: every term, constraint, controller, model modifier, contact model and back
+end, by kind and name.
 
 Plugins are modules named by entry points in the ``nmsm`` group (nmsm's own built-ins
 included). Each implements hooks of :mod:`nmsm.hookspecs` returning classes. A class
@@ -43,7 +44,7 @@ import pluggy
 from nmsm.core.origins import origin_of, record_origin  # noqa: F401  (origin_of: part of this module's API)
 from nmsm.core.term import Term, TermSpec, _location, parse_bool, term_class_problems
 from nmsm.errors import InputError, RegistryError
-from nmsm.hookspecs import ENTRY_POINT_GROUP, PROJECT_NAME, NmsmHookSpecs
+from nmsm.hookspecs import BUILTIN_PLUGINS, ENTRY_POINT_GROUP, PROJECT_NAME, NmsmHookSpecs
 
 #: kind -> hook name
 KINDS: dict[str, str] = {
@@ -52,6 +53,7 @@ KINDS: dict[str, str] = {
     "controller": "nmsm_controllers",
     "modifier": "nmsm_model_modifiers",
     "contact": "nmsm_contact_models",
+    "backend": "nmsm_backends",
 }
 
 #: kind -> the base class its hook's classes subclass (module, class name): imported when checked
@@ -61,6 +63,7 @@ BASES: dict[str, tuple[str, str]] = {
     "controller": ("nmsm.core.plugin_bases", "Controller"),
     "modifier": ("nmsm.core.plugin_bases", "ModelModifier"),
     "contact": ("nmsm.core.plugin_bases", "ContactModel"),
+    "backend": ("nmsm.core.backends.base", "Backend"),
 }
 
 #: Tool codes used in ``tools`` class attributes.
@@ -289,6 +292,7 @@ def discover_plugins() -> list[PluginSource]:
                 continue
             seen.add(key)
             found.append(PluginSource(ep.name, ep.value, dist_name, dist.version, ep.load))
+    found += _builtins_missing_from(found)
     installed = {_normalize(src.distribution): src.distribution for src in found}
     for variable, names in (("NMSM_LOAD_PLUGINS", only), ("NMSM_DISABLE_PLUGINS", disabled)):
         unknown = [name for name in names if _normalize(name) not in installed and _normalize(name) != PROJECT_NAME]
@@ -308,6 +312,21 @@ def discover_plugins() -> list[PluginSource]:
     ]
     # nmsm's own first: a clash with a built-in name then blames the plugin
     return sorted(out, key=lambda src: (not src.is_nmsm, _normalize(src.distribution), src.name))
+
+
+def _builtins_missing_from(found: list[PluginSource]) -> list[PluginSource]:
+    """nmsm's own plugin modules (:data:`~nmsm.hookspecs.BUILTIN_PLUGINS`) that the installed
+    nmsm's entry points do not name: an editable install keeps the entry points of the day it
+    was installed, and a built-in module added since is loaded all the same."""
+    import importlib
+
+    own = [src for src in found if src.is_nmsm]
+    if not own:
+        return []
+    named = {src.value for src in own}
+    return [PluginSource(name, value, own[0].distribution, own[0].version,
+                         lambda value=value: importlib.import_module(value))
+            for name, value in BUILTIN_PLUGINS.items() if value not in named]
 
 
 def _describe(obj: object) -> str:

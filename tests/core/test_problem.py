@@ -67,6 +67,10 @@ def test_matrix_variable_column_major_roundtrip() -> None:
     np.testing.assert_allclose(sol["w"], init * 2, atol=1e-8)
 
 
-def test_unknown_backend(rosenbrock) -> None:
-    with pytest.raises(ValueError, match="unknown back end"):
+def test_unknown_backend_lists_the_registered_ones(rosenbrock) -> None:
+    from nmsm.errors import RegistryError
+
+    with pytest.raises(RegistryError, match=r"unknown back end 'simplex'; registered back ends: .*ipopt.*least_squares"):
         rosenbrock().solve("simplex")
+    with pytest.raises(RegistryError, match="did you mean 'ipopt'"):
+        rosenbrock().solve("ipot")

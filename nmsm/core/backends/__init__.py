@@ -1,21 +1,15 @@
-"""Back ends that solve an :class:`~nmsm.core.problem.OptimizationProblem`."""
+"""Back ends: the solvers a problem is handed to, registered by name.
+
+``problem.solve(name, **options)`` finds the back end registered as ``name``
+(:func:`~nmsm.core.backends.base.get_backend`) and returns its
+:class:`~nmsm.core.solution.Solution`. nmsm's own (``builtin.py``): ``ipopt``
+(:mod:`~nmsm.core.backends.ipopt`) and ``least_squares``
+(:mod:`~nmsm.core.backends.least_squares`). A plugin adds its own through the
+``nmsm_backends`` hook (docs/plugins.md).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from nmsm.core.backends.base import Backend, backend_names, get_backend
 
-BACKENDS = ("least_squares", "ipopt")
-
-
-def get_backend(name: str) -> Callable[..., Any]:
-    """The solve function of back end ``name``."""
-    if name == "least_squares":
-        from nmsm.core.backends.least_squares import solve_least_squares
-
-        return solve_least_squares
-    if name == "ipopt":
-        from nmsm.core.backends.ipopt import solve_ipopt
-
-        return solve_ipopt
-    raise ValueError(f"unknown back end '{name}' (expected one of {', '.join(BACKENDS)})")
+__all__ = ["Backend", "backend_names", "get_backend"]

@@ -9,11 +9,12 @@ from __future__ import annotations
 import ctypes.util
 import time
 import warnings
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import casadi as cs
 import numpy as np
 
+from nmsm.core.backends.base import Backend
 from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import SolveInterrupted, interrupt_after_solve
@@ -139,6 +140,16 @@ def solve_ipopt(
     if stop is not None:
         raise SolveInterrupted(str(stop) or "stopped by SIGINT during the solve", solution) from stop
     return solution
+
+
+class IpoptBackend(Backend):
+    """IPOPT through CasADi ``nlpsol`` (:func:`solve_ipopt`): costs, constraints and bounds of an
+    :class:`~nmsm.core.problem.OptimizationProblem`, exact first and second derivatives."""
+
+    type: ClassVar[str] = "ipopt"
+
+    def solve(self, problem: OptimizationProblem, **options: Any) -> Solution:
+        return solve_ipopt(problem, **options)
 
 
 class _IterateCallback(cs.Callback):

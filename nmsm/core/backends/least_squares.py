@@ -8,13 +8,14 @@ IPOPT back end.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import casadi as cs
 import numpy as np
 import scipy.optimize
 import scipy.sparse
 
+from nmsm.core.backends.base import Backend
 from nmsm.core.backends.sparse import SparseOutput
 from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.solution import Solution
@@ -110,6 +111,16 @@ def solve_least_squares(
         x_scaled=x_opt,
         history=history.result() if history is not None else None,
     )
+
+
+class LeastSquaresBackend(Backend):
+    """scipy's ``least_squares`` (:func:`solve_least_squares`): the weighted residuals of an
+    :class:`~nmsm.core.problem.OptimizationProblem` with bounds only, exact sparse Jacobians."""
+
+    type: ClassVar[str] = "least_squares"
+
+    def solve(self, problem: OptimizationProblem, **options: Any) -> Solution:
+        return solve_least_squares(problem, **options)
 
 
 class LeastSquaresHistory:
