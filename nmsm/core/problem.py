@@ -12,6 +12,12 @@ Objective: ``sum_k weight_k * sum(residuals_k**2)``.
 
 Variables are optimized in scaled form ``x = offset + scale * x_scaled``; the problem
 hands unscaled expressions to the tool so terms never see the scaling.
+
+A *lifted parameter* (:meth:`OptimizationProblem.lifted_parameter`) is a parameter that
+stands for an expression of the design variables, affine in them, so that terms are built on
+its symbol and a back end can differentiate through it cheaply; only the back end
+``lifted_least_squares`` keeps it equal to its expression while solving, and the others
+refuse such a problem.
 """
 
 from __future__ import annotations
@@ -102,6 +108,8 @@ class OptimizationProblem:
         self.parameters: dict[str, Parameter] = {}
         self.costs: list[CostEntry] = []
         self.constraints: list[ConstraintEntry] = []
+        #: lifted parameter name -> the expression of the design variables it stands for
+        self.lifted: dict[str, cs.MX] = {}
         self._n = 0
 
     # ---- declaration -------------------------------------------------------------------
@@ -162,6 +170,31 @@ class OptimizationProblem:
         sym = cs.MX.sym(name, shape[0], shape[1])
         self.parameters[name] = Parameter(name, shape, arr.reshape(shape), sym)
         return sym
+
+    def lifted_parameter(self, name: str, expression: Any, value: Any) -> cs.MX:
+        """Declare a parameter standing for ``expression``, an affine expression of the design
+        variables; returns its MX symbol, to build terms on in place of the expression.
+
+        ``value`` is the expression's value at the initial point (the parameter's value until a
+        back end stores its value at the solution). Solved by ``lifted_least_squares``
+        (:mod:`nmsm.core.backends.lifted_least_squares`).
+        """
+        expr = cs.MX(expression)
+        symbol = self.parameter(name, value)
+        if expr.shape != symbol.shape:
+            del self.parameters[name]
+            raise ValueError(f"lifted parameter '{name}': expression of shape {expr.shape}, value of shape "
+                             f"{symbol.shape}")
+        self.lifted[name] = expr
+        return symbol
+
+    def require_no_lifted_parameters(self, backend: str) -> None:
+        """:class:`ValueError` when the problem has lifted parameters, which ``backend`` would
+        hold at their stored values instead of following the design variables."""
+        if self.lifted:
+            raise ValueError(f"problem '{self.name}' has lifted parameters ({', '.join(list(self.lifted)[:5])}), "
+                             f"which the {backend} back end cannot follow: use backend='lifted_least_squares', "
+                             "or build the problem without lifting")
 
     def set_parameter(self, name: str, value: Any) -> None:
         p = self.parameters[name]

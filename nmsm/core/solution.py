@@ -22,7 +22,8 @@ class ConstraintStatus:
 
 @attrs.frozen
 class Solution:
-    """Result of a solve. ``values`` are unscaled, in each variable's shape."""
+    """Result of a solve. ``values`` are unscaled, in each variable's shape; ``evaluations``
+    counts the residual (and Jacobian) evaluations where the back end reports them."""
 
     values: dict[str, np.ndarray]
     cost: float
@@ -35,6 +36,7 @@ class Solution:
     x_scaled: np.ndarray
     constraints: tuple[ConstraintStatus, ...] = ()
     history: ConvergenceHistory | None = None
+    evaluations: int | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.values[name]

@@ -3,6 +3,7 @@ and a plugin's alike."""
 
 from __future__ import annotations
 
+import re
 import sys
 import textwrap
 from pathlib import Path
@@ -19,50 +20,18 @@ from nmsm.hookspecs import BUILTIN_PLUGINS
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: a plugin's back end: projected gradient descent on the problem's weighted residuals
-_BACKEND_MODULE = """
-    import time
-    from typing import ClassVar
 
-    import casadi as cs
-    import numpy as np
-
-    from nmsm.core.backends import Backend
-    from nmsm.core.solution import Solution
-    from nmsm.hookspecs import hookimpl
-
-    class GradientDescent(Backend):
-        '''Projected gradient descent with a fixed step (a plugin's back end).'''
-
-        type: ClassVar[str] = "gradient_descent"
-        calls: ClassVar[list] = []
-
-        def solve(self, problem, *, step=0.004, iterations=200):
-            type(self).calls.append(problem.name)
-            xs, ps = problem.scaled_vector(), problem.parameter_vector()
-            f = problem.objective()
-            grad = cs.Function("grad", [xs, ps], [f, cs.gradient(f, xs)])
-            lo, hi = problem.bounds_scaled()
-            x, p = np.clip(problem.initial_scaled(), lo, hi), problem.parameter_values()
-            start = time.perf_counter()
-            for _ in range(iterations):
-                cost, g = grad(x, p)
-                x = np.clip(x - step * np.asarray(g).ravel(), lo, hi)
-            return Solution(values=problem.unpack(x), cost=float(cost), term_costs=problem.term_costs(x),
-                            success=True, status="fixed iterations", iterations=iterations,
-                            wall_time=time.perf_counter() - start, backend=self.type, x_scaled=x)
-
-    @hookimpl
-    def nmsm_backends():
-        return [GradientDescent]
-"""
+def _documented_backend() -> str:
+    """The back end of docs/plugins.md ("A back end"), as written there."""
+    text = (ROOT / "docs" / "plugins.md").read_text(encoding="utf-8")
+    return re.search(r"```python\n(.*?)```", text[text.index("## 5. A back end"):], re.S).group(1)
 
 
 @pytest.fixture
 def plugin_backend(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
-    """An installed-looking distribution whose entry point registers ``gradient_descent``;
-    the process registry rebuilt with it (and rebuilt without it afterwards)."""
-    (tmp_path / "fake_backend_plugin.py").write_text(textwrap.dedent(_BACKEND_MODULE))
+    """An installed-looking distribution whose entry point names the documented back end
+    (``lbfgsb``); the process registry rebuilt with it (and rebuilt without it afterwards)."""
+    (tmp_path / "fake_backend_plugin.py").write_text(_documented_backend())
     info = tmp_path / "fake_backend_plugin-1.0.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: fake-backend-plugin\nVersion: 1.0\n")
@@ -81,17 +50,25 @@ def test_builtin_backends_come_through_the_hook() -> None:
     assert type(get_backend("ipopt")).__name__ == "IpoptBackend"
 
 
-def test_plugin_backend_is_found_by_name_and_used(plugin_backend: Path) -> None:
-    assert "gradient_descent" in backend_names()
-    (item,) = [it for it in get_registry().items("backend") if it.name == "gradient_descent"]
+def test_plugin_backend_is_found_by_name_and_used(plugin_backend: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert "lbfgsb" in backend_names()
+    (item,) = [it for it in get_registry().items("backend") if it.name == "lbfgsb"]
     assert item.distribution == "fake-backend-plugin" and item.version == "1.0"
+    calls = []
+    documented = sys.modules["fake_backend_plugin"].LbfgsB
+    solve = documented.solve
+    monkeypatch.setattr(documented, "solve", lambda self, problem, **options: calls.append(problem.name) or
+                        solve(self, problem, **options))
     problem = OptimizationProblem("through_plugin")
     x = problem.variable("x", [0.0, 0.0], lower=-5, upper=[5, 1.5])
     problem.add_cost("fit", x - cs.DM([1.0, 2.0]))
-    solution = problem.solve("gradient_descent")
-    assert solution.backend == "gradient_descent"
-    assert sys.modules["fake_backend_plugin"].GradientDescent.calls == ["through_plugin"]
-    np.testing.assert_allclose(solution["x"].ravel(), [1.0, 1.5], atol=1e-9)
+    solution = problem.solve("lbfgsb", maxiter=200)
+    assert calls == ["through_plugin"]
+    assert solution.backend == "lbfgsb" and solution.success
+    np.testing.assert_allclose(solution["x"].ravel(), [1.0, 1.5], atol=1e-6)
+    with pytest.raises(RegistryError, match=r"unknown back end 'lbfgs' \(did you mean 'lbfgsb'\?\); registered "
+                                            r"back ends: .*lbfgsb"):
+        problem.solve("lbfgs")
 
 
 def test_a_backend_that_is_no_backend_class_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

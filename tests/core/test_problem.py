@@ -9,7 +9,7 @@ import pytest
 from nmsm.core.problem import OptimizationProblem
 
 
-@pytest.mark.parametrize("backend", ["least_squares", "ipopt"])
+@pytest.mark.parametrize("backend", ["least_squares", "ipopt", "levenberg_marquardt"])
 def test_rosenbrock_minimum(rosenbrock, backend: str) -> None:
     sol = rosenbrock().solve(backend, **({"print_level": 0} if backend == "ipopt" else {}))
     assert sol.success
@@ -56,6 +56,8 @@ def test_least_squares_rejects_constraints() -> None:
     prob.add_constraint("g", x, 1, 2)
     with pytest.raises(ValueError, match="least-squares back end handles bounds only"):
         prob.solve("least_squares")
+    with pytest.raises(ValueError, match="levenberg_marquardt back end handles bounds only"):
+        prob.solve("levenberg_marquardt")
 
 
 def test_matrix_variable_column_major_roundtrip() -> None:

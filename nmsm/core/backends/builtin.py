@@ -5,9 +5,11 @@ from __future__ import annotations
 
 from nmsm.core.backends.ipopt import IpoptBackend
 from nmsm.core.backends.least_squares import LeastSquaresBackend
+from nmsm.core.backends.lifted_least_squares import LiftedLeastSquaresBackend
+from nmsm.core.backends.levenberg_marquardt import LevenbergMarquardtBackend
 from nmsm.hookspecs import hookimpl
 
 
 @hookimpl
 def nmsm_backends() -> list[type]:
-    return [IpoptBackend, LeastSquaresBackend]
+    return [IpoptBackend, LeastSquaresBackend, LevenbergMarquardtBackend, LiftedLeastSquaresBackend]

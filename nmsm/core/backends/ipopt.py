@@ -78,6 +78,7 @@ def solve_ipopt(
     """Solve ``problem`` with IPOPT; ``hessian`` is 'exact' or 'limited-memory'."""
     if hessian not in ("exact", "limited-memory"):
         raise ValueError(f"hessian must be 'exact' or 'limited-memory', got '{hessian}'")
+    problem.require_no_lifted_parameters("ipopt")
     xs = problem.scaled_vector()
     ps = problem.parameter_vector()
     g, lbg, ubg = problem.constraint_vector()

@@ -50,6 +50,7 @@ def solve_least_squares(
         )
     if extra:
         raise TypeError(f"unknown least-squares options: {', '.join(extra)}")
+    problem.require_no_lifted_parameters("least_squares")
     xs = problem.scaled_vector()
     ps = problem.parameter_vector()
     r = problem.residual_vector()

@@ -13,9 +13,8 @@ Entry point: :func:`nmsm.tools.gcp.run.run_settings` (``nmsm run`` dispatches
 ``values``       modeled and experimental quantities of a foot for a design (MX or DM)
 ``neighbors``    the neighbor spring-constant deviation (exact, from the toe angle)
 ``context``      what the cost terms (``nmsm/terms/gcp``) ask for, and GCP's reduction
-``problem``      one task as an ``OptimizationProblem``; solver options
-``solver``       the task's solve, exact Jacobians through the lifted foot coordinates
-``blas_threads`` one OpenBLAS thread while the solver runs
+``problem``      one task as an ``OptimizationProblem`` with the foot coordinates lifted; solver
+                 options (solved by the back end ``lifted_least_squares``)
 ``rest_length``  initial resting spring length
 ``outputs``, ``write``, ``filtering``, ``ik_update``  result files (tools.md §6.7)
 ``report``       the RMS error table (Table 4 layout); ``compare`` scores finished results

@@ -17,11 +17,11 @@ block                           name                  bounds            scale
 ``forcePlateRotation``          plate_rotation_<foot> +-0.2618 rad      (range)
 ==============================  ====================  ================  =========
 
-``<foot>`` is the 1-based foot index. Solved by :func:`nmsm.tools.gcp.solver.solve_task`
-(scipy ``least_squares`` 'trf', exact sparse Jacobians through the lifted foot
-coordinates, LSMR trust-region steps: the Jacobian has ~40 times more rows than columns
-and an SVD of it per iteration costs more than the Jacobian itself, for the same steps
-here). Options from the settings: ``function_tolerance`` -> ``ftol``,
+``<foot>`` is the 1-based foot index. Solved by the back end ``lifted_least_squares``
+(:mod:`nmsm.core.backends.lifted_least_squares`: scipy ``least_squares`` 'trf', exact sparse
+Jacobians through the lifted foot coordinates, LSMR trust-region steps: the Jacobian has
+~40 times more rows than columns and an SVD of it per iteration costs more than the
+Jacobian itself, for the same steps here). Options from the settings: ``function_tolerance`` -> ``ftol``,
 ``step_tolerance`` -> ``xtol``, ``optimality_tolerance`` -> ``gtol``, ``max_iterations``
 -> the number of residual evaluations (each trust-region iteration evaluates the residuals
 once and the Jacobian once per accepted step). ``diff_min_change`` (a finite-difference
@@ -54,9 +54,9 @@ _AXES = "xyz"
 class TaskProblem:
     """A built task: the problem, its context (for terms) and the modeled values.
 
-    ``lifted`` maps problem parameters standing for foot coordinates (``q_<foot>``,
-    ``qdot_<foot>``, (7, T)) to their expressions of the design variables; they must equal
-    those expressions wherever the problem is evaluated (:mod:`nmsm.tools.gcp.solver`).
+    With lifting, the problem's lifted parameters (``problem.lifted``) are the foot
+    coordinates ``q_<foot>`` and rates ``qdot_<foot>`` (7, T), standing for their expressions
+    of the design variables.
     """
 
     problem: OptimizationProblem
@@ -64,7 +64,6 @@ class TaskProblem:
     values: list[FootValues]
     design: Design
     terms: list[Term]
-    lifted: dict[str, Any] = attrs.field(factory=dict)
 
 
 def _scalar(problem: OptimizationProblem, optimize: bool, name: str, value: float, **kw: Any) -> Any:
@@ -108,30 +107,37 @@ def build_task_problem(feet: Sequence[FootInputs], state: GcpState, task: GcpTas
     """The task's problem with ``terms`` (registered GCP cost terms) added.
 
     With ``lift`` and optimized kinematics, each foot's coordinates and rates enter the
-    terms through parameters ``q_<foot>``/``qdot_<foot>`` (see :class:`TaskProblem`).
+    terms through lifted parameters ``q_<foot>``/``qdot_<foot>`` (see :class:`TaskProblem`).
     """
     problem = OptimizationProblem(name)
     design = build_design(problem, state, task.design_flags)
-    lifted: dict[str, Any] = {}
     values = []
     for i, foot in enumerate(feet):
         q, qdot = foot_coordinates(foot, design.coefficients[i])
         if lift and task.design_flags["kinematicsBSplineCoefficients"]:
             numeric = foot_coordinates(foot, cs.DM(state.coefficients[i]))
-            lifted[f"q_{foot.index}"], lifted[f"qdot_{foot.index}"] = q, qdot
-            coordinates = (problem.parameter(f"q_{foot.index}", np.array(numeric[0])),
-                           problem.parameter(f"qdot_{foot.index}", np.array(numeric[1])))
+            coordinates = (problem.lifted_parameter(f"q_{foot.index}", q, np.array(numeric[0])),
+                           problem.lifted_parameter(f"qdot_{foot.index}", qdot, np.array(numeric[1])))
             values.append(foot_values(foot, design, i, coordinates=coordinates))
         else:
             values.append(foot_values(foot, design, i, coordinates=(q, qdot)))
     context = GcpContext(feet, values, design, task.neighborStandardDeviation)
     for term in terms:
         problem.add_term(term, context)
-    return TaskProblem(problem, context, values, design, list(terms), lifted)
+    return TaskProblem(problem, context, values, design, list(terms))
+
+
+#: the back end that solves a task (:mod:`nmsm.core.backends.lifted_least_squares`)
+BACKEND = "lifted_least_squares"
+
+
+def solve_task(task: TaskProblem, **options: Any) -> Solution:
+    """Solve a built task with :data:`BACKEND` (``options``: :func:`solver_options`, ``verbose``)."""
+    return task.problem.solve(BACKEND, **options)
 
 
 def solver_options(settings: GroundContactPersonalizationSettings, max_iterations: int | None = None) -> dict[str, Any]:
-    """Least-squares options from the settings (module docstring)."""
+    """Options of :data:`BACKEND` from the settings (module docstring)."""
     iterations = settings.max_iterations if max_iterations is None else max_iterations
     return {
         "ftol": settings.function_tolerance,

@@ -61,9 +61,8 @@ from nmsm.model.osim import load_model
 from nmsm.tools.gcp import report
 from nmsm.tools.gcp.data import read_ground_reactions, read_motion
 from nmsm.tools.gcp.inputs import FootInputs, build_foot_inputs, check_equal_spring_counts
-from nmsm.tools.gcp.problem import build_task_problem, solver_options, updated_state
+from nmsm.tools.gcp.problem import build_task_problem, solve_task, solver_options, updated_state
 from nmsm.tools.gcp.rest_length import initialize_resting_length
-from nmsm.tools.gcp.solver import solve_task
 from nmsm.tools.gcp.state import GcpState
 from nmsm.tools.gcp.values import FootValues, foot_values
 from nmsm.tools.gcp.write import write_results

@@ -81,7 +81,7 @@ def foot_values(foot: FootInputs, design: Design, index: int, *, coordinates: tu
     """The :class:`FootValues` of ``foot`` (position ``index`` in the design's foot lists).
 
     ``coordinates``: ``(q, qdot)`` (7, T) to use instead of :func:`foot_coordinates` of the
-    design's coefficients (symbols standing for them: see :mod:`nmsm.tools.gcp.solver`).
+    design's coefficients (symbols standing for them: see :mod:`nmsm.core.backends.lifted_least_squares`).
     """
     q, qdot = coordinates if coordinates is not None else foot_coordinates(foot, design.coefficients[index])
     frames = foot.n_frames

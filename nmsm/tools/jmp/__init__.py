@@ -13,10 +13,11 @@ Public API (imported lazily: importing this package loads no CasADi)::
 
 Modules (one job each): ``ik`` (per-frame IK), ``ik_settings`` (OpenSim IK settings files),
 ``marker_data`` (markers, frames, gaps, units), ``marker_model`` (markers as CasADi functions
-of free coordinates and model parameters), ``levenberg_marquardt`` (bound-constrained LM with
-dense / sparse / block-arrow linear algebra), ``dense_evaluator`` (CasADi calls on numpy
+of free coordinates and model parameters), ``dense_evaluator`` (CasADi calls on numpy
 buffers), ``design`` (a task's design variables and bounds), ``problem`` (one task as one
-least-squares problem over all frames and the parameters), ``model_output`` (writing the
+least-squares problem over all frames and the parameters, a
+:class:`~nmsm.core.residual_problem.ResidualProblem` solved by the ``levenberg_marquardt``
+back end), ``model_output`` (writing the
 personalized ``.osim``), ``task`` (one task end to end), ``report``, ``run`` (settings file
 to results folder), ``cli`` (``nmsm ik``).
 """

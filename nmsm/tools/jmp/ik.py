@@ -12,7 +12,7 @@ frame. The first frame starts from the model's default pose (as OpenSim's ``asse
 and, when a clamped coordinate's default sits on a bound of its range, also from that pose
 with such coordinates at mid-range; the lower cost wins (:func:`first_frame_starts`). Every
 later frame starts from the previous solution. Each frame is a small bound-constrained
-Levenberg-Marquardt solve (:mod:`~nmsm.tools.jmp.levenberg_marquardt`) on a CasADi SX
+Levenberg-Marquardt solve (:mod:`~nmsm.core.backends.levenberg_marquardt`) on a CasADi SX
 function giving residuals and their exact Jacobian.
 
 Entry points: :func:`inverse_kinematics` (arrays in, :class:`IkResult` out),
@@ -40,7 +40,8 @@ from nmsm.model.osim import load_model
 from nmsm.model.parameters import ModelParameters
 from nmsm.tools.jmp.dense_evaluator import DenseEvaluator
 from nmsm.tools.jmp.ik_settings import CoordinateTask, IkSettings, read_ik_settings
-from nmsm.tools.jmp.levenberg_marquardt import DenseJacobian, Tolerances, solve
+from nmsm.core.backends.levenberg_marquardt import Tolerances, solve
+from nmsm.core.jacobians import DenseJacobian
 from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, frames_in_range, select_trial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
 from nmsm.io.motion_units import warn_implausible_angles

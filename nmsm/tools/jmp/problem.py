@@ -7,7 +7,9 @@ kinematics with the model ``p`` describes (the original's nested IK), without an
 solver and without finite differences: the Jacobian is exact and has a block-arrow
 structure (frame ``f``'s residuals depend on ``q_f`` and ``p`` only) that the Schur
 complement solves in time linear in ``F``
-(:class:`~nmsm.tools.jmp.levenberg_marquardt.BlockArrowJacobian`).
+(:class:`~nmsm.core.jacobians.BlockArrowJacobian`). :class:`JmpProblem` states it as a
+:class:`~nmsm.core.residual_problem.ResidualProblem`, solved by the back end
+``levenberg_marquardt``.
 
 Terms see one frame: :class:`JmpContext` gives the frame's symbolic (SX) quantities and
 reduces a term's normalized values by ``1/sqrt(n_observations)``; the per-frame residual
@@ -21,7 +23,6 @@ cross-check the solver).
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -29,12 +30,15 @@ import attrs
 import casadi as cs
 import numpy as np
 
+from nmsm.core.backends.base import get_backend
+from nmsm.core.backends.levenberg_marquardt import Tolerances
 from nmsm.core.convergence import ConvergenceHistory
+from nmsm.core.jacobians import BlockArrowJacobian
 from nmsm.core.problem import OptimizationProblem
+from nmsm.core.residual_problem import ResidualProblem
 from nmsm.core.term import CostTerm
 from nmsm.core.threads import SOLVER_THREADS, thread_map
 from nmsm.tools.jmp.dense_evaluator import DenseEvaluator
-from nmsm.tools.jmp.levenberg_marquardt import BlockArrowJacobian, LeastSquaresResult, Tolerances, solve
 from nmsm.tools.jmp.marker_data import MarkerTrial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
 
@@ -90,8 +94,10 @@ class JmpSolution:
     history: ConvergenceHistory | None = None
 
 
-class JmpProblem:
+class JmpProblem(ResidualProblem):
     """The least-squares problem of one task (see module docstring)."""
+
+    name = "jmp"
 
     def __init__(self, kinematics: MarkerKinematics, trial: MarkerTrial, terms: Sequence[CostTerm],
                  p_lower: np.ndarray, p_upper: np.ndarray, *, workers: int = SOLVER_THREADS) -> None:
@@ -172,19 +178,29 @@ class JmpProblem:
             out[key] = float(value)
         return out
 
+    def values(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """``q`` ``(F, n_free)`` and ``p`` ``(k,)`` of ``x``."""
+        q, p = self.unpack(x)
+        return {"q": q, "p": p}
+
+    def costs(self, x: np.ndarray) -> dict[str, float]:
+        return self.term_costs(*self.unpack(x))
+
     def solve(self, q0: np.ndarray, p0: np.ndarray, tolerances: Tolerances = Tolerances(), *,
-              callback: Callable[[int, float, np.ndarray], None] | None = None) -> JmpSolution:
-        """Solve from coordinates ``q0`` ``(F, n_free)`` and parameters ``p0`` ``(k,)``."""
+              callback: Callable[[int, float, np.ndarray], None] | None = None,
+              backend: str = "levenberg_marquardt") -> JmpSolution:
+        """Solve from coordinates ``q0`` ``(F, n_free)`` and parameters ``p0`` ``(k,)`` with the
+        back end ``backend`` (one that takes a :class:`~nmsm.core.residual_problem.ResidualProblem`
+        and the :class:`~nmsm.core.backends.levenberg_marquardt.Tolerances` as options)."""
         lower, upper = self.bounds()
         x0 = np.clip(self.pack(q0, p0), lower, upper)
         r0, _ = self.evaluate(x0)
-        start = time.perf_counter()
-        result: LeastSquaresResult = solve(self.evaluate, x0, lower, upper, tolerances, callback)
-        wall = time.perf_counter() - start
-        q, p = self.unpack(result.x)
-        return JmpSolution(q=q, p=p, cost=result.cost, initial_cost=float(r0 @ r0), term_costs=self.term_costs(q, p),
-                           converged=result.converged, status=result.status, iterations=result.iterations,
-                           evaluations=result.evaluations, wall_time=wall, history=result.history)
+        solution = get_backend(backend).solve(self, initial_guess=x0, callback=callback, **attrs.asdict(tolerances))
+        return JmpSolution(q=solution.values["q"], p=solution.values["p"], cost=solution.cost,
+                           initial_cost=float(r0 @ r0), term_costs=solution.term_costs, converged=solution.success,
+                           status=solution.status, iterations=solution.iterations,
+                           evaluations=int(solution.evaluations or 0), wall_time=solution.wall_time,
+                           history=solution.history)
 
     def optimization_problem(self, q0: np.ndarray, p0: np.ndarray) -> OptimizationProblem:
         """The same problem as a generic :class:`OptimizationProblem` (variables ``q``

@@ -51,7 +51,7 @@ from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.jmp import JointModelPersonalizationSettings
 from nmsm.io.storage import write_storage
 from nmsm.tools.jmp.ik import marker_error_table, write_motion
-from nmsm.tools.jmp.levenberg_marquardt import Tolerances
+from nmsm.core.backends.levenberg_marquardt import Tolerances
 from nmsm.tools.jmp.report import error_rows, format_task, rows_to_json, write_json
 from nmsm.tools.jmp.task import TaskResult, run_task
 

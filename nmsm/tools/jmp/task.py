@@ -26,7 +26,7 @@ from nmsm.io.trc import read_trc
 from nmsm.model.osim import load_model
 from nmsm.tools.jmp.design import TaskDesign, build_design
 from nmsm.tools.jmp.ik import IkResult, inverse_kinematics
-from nmsm.tools.jmp.levenberg_marquardt import Tolerances
+from nmsm.core.backends.levenberg_marquardt import Tolerances
 from nmsm.tools.jmp.marker_data import MarkerTrial, check_units, select_trial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
 from nmsm.tools.jmp.model_output import write_task_model

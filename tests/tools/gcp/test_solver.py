@@ -1,5 +1,5 @@
-"""The lifted chain-rule Jacobian equals CasADi's Jacobian through the kinematic
-coefficients, and the residuals are the same."""
+"""The lifted chain-rule Jacobian (back end ``lifted_least_squares``) equals CasADi's Jacobian
+through the kinematic coefficients, and the residuals are the same."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from nmsm.io.settings.gcp import GroundContactPersonalizationSettings
 from nmsm.tools.gcp.problem import build_task_problem
 from nmsm.tools.gcp.run import load_feet
 from nmsm.core.backends.sparse import dm_to_csc
-from nmsm.tools.gcp.solver import LiftedResiduals
+from nmsm.core.backends.lifted_least_squares import LiftedResiduals
 from nmsm.tools.gcp.state import GcpState
 
 
@@ -27,12 +27,12 @@ def test_lifted_jacobian_is_exact(synthetic_case):
     state.coefficients = [c + 0.01 * rng.standard_normal(c.shape) for c in state.coefficients]
     lifted_task = build_task_problem(feet, state, task, terms, lift=True)
     direct_task = build_task_problem(feet, state, task, terms, lift=False)
-    assert set(lifted_task.lifted) == {"q_1", "qdot_1"} and not direct_task.lifted
+    assert set(lifted_task.problem.lifted) == {"q_1", "qdot_1"} and not direct_task.problem.lifted
     direct = direct_task.problem
     xs, ps = direct.scaled_vector(), direct.parameter_vector()
     r = direct.residual_vector()
     f = cs.Function("f", [xs, ps], [r, cs.jacobian(r, xs)])
-    lifted = LiftedResiduals(lifted_task)
+    lifted = LiftedResiduals(lifted_task.problem)
     for _ in range(2):
         x = direct.initial_scaled() + 0.01 * rng.standard_normal(direct.n_variables)
         r_direct, j_direct = f(x, direct.parameter_values())
@@ -42,7 +42,7 @@ def test_lifted_jacobian_is_exact(synthetic_case):
 
 
 def test_single_threaded_blas_sets_and_restores_thread_counts():
-    from nmsm.tools.gcp.blas_threads import _controls, single_threaded_blas
+    from nmsm.core.blas_threads import _controls, single_threaded_blas
 
     controls = _controls()
     before = [get() for _, get in controls]

@@ -12,7 +12,7 @@ from nmsm.model import load_model
 from nmsm.terms.jmp.marker_distance import MarkerDistanceError
 from nmsm.tools.jmp.design import build_design
 from nmsm.tools.jmp.ik import inverse_kinematics
-from nmsm.tools.jmp.levenberg_marquardt import Tolerances
+from nmsm.core.backends.levenberg_marquardt import Tolerances
 from nmsm.tools.jmp.marker_data import select_trial
 from nmsm.tools.jmp.marker_model import MarkerKinematics
 from nmsm.tools.jmp.problem import JmpProblem
@@ -57,7 +57,8 @@ def test_small_range_of_motion_warns(tmp_path):
 
 
 def test_generic_least_squares_back_end_agrees(tmp_path):
-    """The same task as an OptimizationProblem solved by scipy through the generic back end."""
+    """The same task as an OptimizationProblem solved by scipy, and by Levenberg-Marquardt on its
+    sparse Jacobian, through the generic back ends."""
     case = make_synthetic_jmp_case(tmp_path, noise=0.0005, duration=0.4)
     settings = read_settings(case.settings_file)
     task = settings.tasks[0]
@@ -70,10 +71,14 @@ def test_generic_least_squares_back_end_agrees(tmp_path):
     q0 = before.q[:, [before.coordinate_names.index(n) for n in kin.free_names]]
     problem = JmpProblem(kin, trial, [MarkerDistanceError(max_allowable_error=0.01)], design.lower, design.upper)
     ours = problem.solve(q0, design.initial, Tolerances(xtol=1e-12, ftol=1e-14, gtol=1e-12))
-    generic = problem.optimization_problem(q0, design.initial).solve("least_squares", xtol=1e-12, ftol=1e-14,
-                                                                    gtol=1e-12)
+    stated = problem.optimization_problem(q0, design.initial)
+    generic = stated.solve("least_squares", xtol=1e-12, ftol=1e-14, gtol=1e-12)
     assert generic.cost == pytest.approx(ours.cost, rel=1e-8)
     np.testing.assert_allclose(generic["p"].ravel(), ours.p, atol=1e-7)
+    sparse = stated.solve("levenberg_marquardt", xtol=1e-12, ftol=1e-14, gtol=1e-12)
+    assert sparse.backend == "levenberg_marquardt" and sparse.success
+    assert sparse.cost == pytest.approx(ours.cost, rel=1e-8)
+    np.testing.assert_allclose(sparse["p"].ravel(), ours.p, atol=1e-7)
     assert ours.term_costs["marker_distance_error"] == pytest.approx(ours.cost, rel=1e-12)
 
 

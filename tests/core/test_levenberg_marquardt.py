@@ -7,13 +7,10 @@ import pytest
 import scipy.optimize
 import scipy.sparse
 
-from nmsm.tools.jmp.levenberg_marquardt import (
-    BlockArrowJacobian,
-    DenseJacobian,
-    SparseJacobian,
-    Tolerances,
-    solve,
-)
+from nmsm.core.backends import get_backend
+from nmsm.core.backends.levenberg_marquardt import Tolerances, solve
+from nmsm.core.jacobians import BlockArrowJacobian, DenseJacobian, SparseJacobian
+from nmsm.core.residual_problem import ResidualProblem
 
 
 def _block_to_dense(jac: BlockArrowJacobian) -> np.ndarray:
@@ -98,7 +95,7 @@ def test_small_damped_decrease_is_not_convergence():
 def test_step_re_solved_on_reached_bounds_keeps_the_model_decrease():
     """A variable whose damped step would cross its bound stops on it and the others are
     solved again: the linear model decreases at least as much as with the step clipped."""
-    from nmsm.tools.jmp.levenberg_marquardt import bounded_step
+    from nmsm.core.backends.levenberg_marquardt import bounded_step
 
     rng = np.random.default_rng(3)
     for _ in range(20):
@@ -116,3 +113,32 @@ def test_step_re_solved_on_reached_bounds_keeps_the_model_decrease():
         clipped = np.clip(jac.damped_step(g, free, 1e-6, diag), lower, upper)
         bounded = np.clip(bounded_step(jac, g, free, 1e-6, diag, x, lower, upper), lower, upper)
         assert model_decrease(bounded) >= model_decrease(clipped) - 1e-12
+
+
+class _FreudensteinRoth(ResidualProblem):
+    """A ResidualProblem with a dense Jacobian, bounded so that a bound is active."""
+
+    name = "freudenstein_roth"
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.array([-10.0, -10.0]), np.array([10.0, 3.5])
+
+    def evaluate(self, x: np.ndarray) -> tuple[np.ndarray, DenseJacobian]:
+        return _freudenstein_roth(x)
+
+
+def test_the_backend_solves_a_residual_problem_as_the_algorithm_does():
+    problem = _FreudensteinRoth()
+    x0 = np.array([0.5, -2.0])
+    direct = solve(problem.evaluate, x0, *problem.bounds(), Tolerances(ftol=1e-10))
+    solution = get_backend("levenberg_marquardt").solve(problem, initial_guess=x0, ftol=1e-10)
+    assert solution.backend == "levenberg_marquardt" and solution.success == direct.converged
+    np.testing.assert_array_equal(solution.x_scaled, direct.x)
+    np.testing.assert_array_equal(solution["x"], direct.x)
+    assert solution.cost == direct.cost and solution.term_costs == {"freudenstein_roth": direct.cost}
+    assert (solution.iterations, solution.evaluations, solution.status) == (direct.iterations, direct.evaluations,
+                                                                            direct.status)
+    with pytest.raises(TypeError, match="solved from initial_guess"):
+        get_backend("levenberg_marquardt").solve(problem)
+    with pytest.raises(TypeError, match="unknown levenberg_marquardt options: max_nfev"):
+        get_backend("levenberg_marquardt").solve(problem, initial_guess=x0, max_nfev=3)

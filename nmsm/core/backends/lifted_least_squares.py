@@ -1,51 +1,56 @@
-"""Solve a GCP task with exact Jacobians assembled by the chain rule through the foot
-coordinates.
+"""The back end ``lifted_least_squares``: scipy's ``least_squares`` on a problem with lifted
+parameters, exact Jacobians assembled by the chain rule through them.
 
-A task's residuals depend on the kinematic coefficients ``C`` only through each foot's
-coordinates ``q = (N (base * C))^T`` and rates ``qdot``, which are linear in the scaled
-variables ``x``: ``z(x) = G x + z0``. :func:`~nmsm.tools.gcp.problem.build_task_problem`
-makes ``z`` problem parameters (``lifted``), so the residuals are ``r(x, z)`` and, exactly,
+A lifted parameter (:meth:`~nmsm.core.problem.OptimizationProblem.lifted_parameter`) stands
+for an expression ``z(x)`` of the scaled design variables that is affine in them,
+``z(x) = G x + z0`` (GCP: each foot's coordinates and rates, linear in the B-spline
+coefficients). The residuals are written in terms of the parameter, ``r(x, z)``, and, exactly,
 
     dr/dx = r_x(x, z(x)) + r_z(x, z(x)) G
 
-``r_z`` is cheap for CasADi: each frame's residuals depend on that frame's 14 coordinates
-and rates only, so its forward mode needs about 14 directions through the per-frame map,
-where differentiating through ``C`` directly needs one direction per colour of ``C`` (about
-40). Measured on the tutorial's 8 x 15 grid: 0.7 s per Jacobian instead of 3.2 s.
+``r_z`` can be much cheaper for CasADi than differentiating through ``x`` directly: when each
+sample's residuals depend on that sample's few entries of ``z`` only, its forward mode needs
+about as many directions as a sample has entries, where differentiating through ``x`` needs
+one direction per colour of the whole Jacobian. ``G`` is read once, at ``x = 0``.
 
-The step computation is scipy's ``least_squares`` ('trf', LSMR trust-region steps, bounds),
-as the core back end (:mod:`nmsm.core.backends.least_squares`) runs it; the problem's
-lifted parameters are left at the solution's values.
+The step computation is scipy's ``least_squares`` ('trf', LSMR trust-region steps, bounds
+only), with OpenBLAS on one thread while it runs (:mod:`nmsm.core.blas_threads`). After the
+solve the lifted parameters hold their values at the solution, so the problem evaluates
+(``term_costs``, ``evaluate``) consistently there.
 """
 
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING, Any, ClassVar
+
 import casadi as cs
 import numpy as np
 import scipy.optimize
 import scipy.sparse
 
+from nmsm.core.backends.base import Backend
 from nmsm.core.backends.least_squares import record_history
 from nmsm.core.backends.sparse import SparseOutput, dm_to_csc
-from nmsm.core.problem import OptimizationProblem, Solution
+from nmsm.core.blas_threads import single_threaded_blas
 from nmsm.core.progress import with_least_squares_progress
-from nmsm.tools.gcp.blas_threads import single_threaded_blas
-from nmsm.tools.gcp.problem import TaskProblem
+from nmsm.core.solution import Solution
+
+if TYPE_CHECKING:
+    from nmsm.core.problem import OptimizationProblem
 
 
 class LiftedResiduals:
-    """``r(x)`` and ``dr/dx`` of a task problem with lifted foot coordinates (module docstring)."""
+    """``r(x)`` and ``dr/dx`` of a problem with lifted parameters (module docstring)."""
 
-    def __init__(self, task: TaskProblem) -> None:
-        problem: OptimizationProblem = task.problem
+    def __init__(self, problem: OptimizationProblem) -> None:
         self.problem = problem
         xs, ps = problem.scaled_vector(), problem.parameter_vector()
         r = problem.residual_vector()
-        names = list(task.lifted)
+        names = list(problem.lifted)
         symbols = [problem.parameters[n].symbol for n in names]
         z = cs.vertcat(*[cs.vec(s) for s in symbols]) if symbols else cs.MX(0, 1)
-        z_of_x = cs.vertcat(*[cs.vec(task.lifted[n]) for n in names]) if names else cs.MX(0, 1)
+        z_of_x = cs.vertcat(*[cs.vec(problem.lifted[n]) for n in names]) if names else cs.MX(0, 1)
         self.names = names
         self.f_residuals = cs.Function("residuals", [xs, ps], [r])
         self._jac_x = SparseOutput(cs.Function("jac_x", [xs, ps], [cs.jacobian(r, xs)]))
@@ -60,7 +65,7 @@ class LiftedResiduals:
         self.static = problem.parameter_values()
 
     def parameters(self, x: np.ndarray) -> np.ndarray:
-        """The parameter vector with the lifted coordinates at ``z(x)``."""
+        """The parameter vector with the lifted parameters at ``z(x)``."""
         p = self.static.copy()
         z = np.asarray(self.f_z(x)).ravel()
         offset = 0
@@ -87,15 +92,20 @@ class LiftedResiduals:
             self.problem.set_parameter(name, p[lo:hi].reshape(shape, order="F"))
 
 
-def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_nfev: int,
-               verbose: int = 0) -> Solution:
-    """Solve a built task (bounds only) and return a :class:`~nmsm.core.problem.Solution`."""
-    problem = task.problem
-    lifted = LiftedResiduals(task)
+def solve_lifted_least_squares(problem: OptimizationProblem, *, ftol: float = 1e-8, xtol: float = 1e-8,
+                               gtol: float = 1e-8, max_nfev: int | None = None, verbose: int = 0) -> Solution:
+    """Solve ``problem`` (bounds only; lifted parameters optional) and return a
+    :class:`~nmsm.core.solution.Solution`; options as scipy's ``least_squares``, whose
+    ``max_nfev`` counts residual evaluations."""
+    if problem.constraints:
+        names = ", ".join(c.name for c in problem.constraints[:5])
+        raise ValueError(f"problem '{problem.name}' has constraints ({names}); the lifted_least_squares back end "
+                         "handles bounds only: use backend='ipopt'")
+    lifted = LiftedResiduals(problem)
     x0 = problem.initial_scaled()
     lo, hi = problem.bounds_scaled()
     x0 = np.clip(x0, lo, hi)
-    interior = lo < hi
+    interior = lo < hi  # scipy's 'trf' needs a strictly interior start
     eps = 1e-10 * np.maximum(1.0, np.abs(x0))
     x0 = np.where(interior & (x0 <= lo), np.minimum(lo + eps, hi), x0)
     x0 = np.where(interior & (x0 >= hi), np.maximum(hi - eps, lo), x0)
@@ -120,7 +130,7 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
         fun, jac, history = record_history(fun, jac)
         if not verbose:
             fun, jac = with_least_squares_progress(problem.name, fun, jac)
-        with single_threaded_blas():  # LSMR's many small BLAS calls (nmsm.tools.gcp.blas_threads)
+        with single_threaded_blas():
             result = scipy.optimize.least_squares(
                 fun, x0[free], jac=jac,
                 bounds=(lo[free], hi[free]), method="trf", tr_solver="lsmr", ftol=ftol, xtol=xtol, gtol=gtol,
@@ -131,5 +141,15 @@ def solve_task(task: TaskProblem, *, ftol: float, xtol: float, gtol: float, max_
     term_costs = problem.term_costs(x_opt)
     return Solution(values=problem.unpack(x_opt), cost=float(sum(term_costs.values())), term_costs=term_costs,
                     success=success, status=status, iterations=nfev, wall_time=wall,
-                    backend="least_squares (lifted foot coordinates)", x_scaled=x_opt,
+                    backend=LiftedLeastSquaresBackend.type, x_scaled=x_opt,
                     history=history.result() if history is not None else None)
+
+
+class LiftedLeastSquaresBackend(Backend):
+    """scipy's ``least_squares`` with Jacobians through lifted parameters
+    (:func:`solve_lifted_least_squares`)."""
+
+    type: ClassVar[str] = "lifted_least_squares"
+
+    def solve(self, problem: OptimizationProblem, **options: Any) -> Solution:
+        return solve_lifted_least_squares(problem, **options)

@@ -1,10 +1,9 @@
-"""Single-threaded OpenBLAS while GCP's trust-region solver runs.
+"""Single-threaded OpenBLAS while a trust-region least-squares solver with LSMR steps runs.
 
 scipy's LSMR steps take many norms and dot products of vectors of ~1e4 entries. With the
-bundled OpenBLAS allowed several threads, each such call wakes the BLAS threads; on a loaded
-machine (more runnable processes than cores) one ``np.linalg.norm`` of 14 000 entries was
-measured at 15 ms instead of 20 us single-threaded, and norms took 189 s of a 342 s run of the
-tutorial V4 settings. :func:`single_threaded_blas` sets every OpenBLAS copy loaded in the
+bundled OpenBLAS allowed several threads, each such call wakes the BLAS threads, which on a
+machine with more runnable processes than cores costs far more than the call itself
+(docs/developing.md, GCP). :func:`single_threaded_blas` sets every OpenBLAS copy loaded in the
 process (numpy's and scipy's) to one thread and restores the previous counts afterwards.
 Nothing happens where no OpenBLAS library is found (e.g. another BLAS, non-Linux systems).
 """

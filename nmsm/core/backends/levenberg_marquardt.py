@@ -1,7 +1,12 @@
-"""Bound-constrained Levenberg-Marquardt for nonlinear least squares ``min sum(r(x)**2)``.
+"""Bound-constrained Levenberg-Marquardt for nonlinear least squares ``min sum(r(x)**2)``:
+the back end ``levenberg_marquardt``.
 
-Used by inverse kinematics (one small dense problem per frame) and by Joint Model
-Personalization (all frames' coordinates and the model parameters together). The
+The back end (:class:`LevenbergMarquardtBackend`) solves a
+:class:`~nmsm.core.residual_problem.ResidualProblem` (Joint Model Personalization: all
+frames' coordinates and the model parameters together, a block-arrow Jacobian) or the
+weighted residuals of an :class:`~nmsm.core.problem.OptimizationProblem` with bounds only
+(a sparse Jacobian in the scaled variables). :func:`solve` is the algorithm on a function
+``x -> (r, J)``; inverse kinematics calls it on one small dense problem per frame. The
 Jacobian is exact (CasADi), so each iteration is a Gauss-Newton step regularized by
 Marquardt's scaled damping ``mu * diag(J^T J)``:
 
@@ -22,172 +27,29 @@ Convergence (any of):
 * ``|projected J^T r|_inf <= gtol``                                 (first order)
 * ``cost <= ctol``                                                   (exact fit)
 
-The linear algebra is pluggable: ``fun(x)`` returns ``(r, J)`` with ``J`` one of
-
-* :class:`DenseJacobian` (numpy, small problems: IK frames);
-* :class:`SparseJacobian` (scipy sparse; SuperLU on the damped normal matrix);
-* :class:`BlockArrowJacobian` (JMP: per-frame blocks ``dr_f/dq_f`` and ``dr_f/dp`` with
-  ``x = [q_1, ..., q_F, p]``), solved by the Schur complement on the shared parameters in
-  time linear in the number of frames.
+The linear algebra is the Jacobian's: ``fun(x)`` returns ``(r, J)`` with ``J`` one of
+:mod:`nmsm.core.jacobians` (dense, sparse, block-arrow).
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import attrs
+import casadi as cs
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
 
+from nmsm.core.backends.base import Backend
+from nmsm.core.backends.sparse import SparseOutput
 from nmsm.core.convergence import ConvergenceHistory
+from nmsm.core.jacobians import Jacobian, SparseJacobian
+from nmsm.core.residual_problem import ResidualProblem
+from nmsm.core.solution import Solution
 
-
-class Jacobian(Protocol):
-    """What the algorithm needs from a Jacobian ``J`` (m x n)."""
-
-    def gradient(self, r: np.ndarray) -> np.ndarray:
-        """``J^T r`` (n,)."""
-
-    def normal_diagonal(self) -> np.ndarray:
-        """``diag(J^T J)`` (n,)."""
-
-    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
-        """``s`` with ``(J^T J + mu diag(diag))_ff s_f = -g_f`` and ``s = 0`` off ``free``."""
-
-    def product(self, s: np.ndarray) -> np.ndarray:
-        """``J s`` (m,)."""
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        """``|J s|^2``."""
-
-
-@attrs.frozen
-class DenseJacobian:
-    """A numpy Jacobian ``(m, n)``."""
-
-    matrix: np.ndarray
-
-    def gradient(self, r: np.ndarray) -> np.ndarray:
-        return self.matrix.T @ r
-
-    def normal_diagonal(self) -> np.ndarray:
-        return np.einsum("ij,ij->j", self.matrix, self.matrix)
-
-    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
-        idx = np.flatnonzero(free)
-        step = np.zeros_like(g)
-        if idx.size == 0:
-            return step
-        j = self.matrix[:, idx]
-        a = j.T @ j
-        a[np.diag_indices_from(a)] += mu * diag[idx]
-        try:
-            step[idx] = -np.linalg.solve(a, g[idx])
-        except np.linalg.LinAlgError:
-            step[idx] = -np.linalg.lstsq(a, g[idx], rcond=None)[0]
-        return step
-
-    def product(self, s: np.ndarray) -> np.ndarray:
-        return np.asarray(self.matrix @ s).ravel()
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.product(s)
-        return float(v @ v)
-
-
-@attrs.frozen
-class SparseJacobian:
-    """A scipy sparse Jacobian ``(m, n)``."""
-
-    matrix: scipy.sparse.csc_matrix
-
-    def gradient(self, r: np.ndarray) -> np.ndarray:
-        return np.asarray(self.matrix.T @ r).ravel()
-
-    def normal_diagonal(self) -> np.ndarray:
-        return np.asarray(self.matrix.multiply(self.matrix).sum(axis=0)).ravel()
-
-    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
-        idx = np.flatnonzero(free)
-        step = np.zeros_like(g)
-        if idx.size == 0:
-            return step
-        j = self.matrix[:, idx]
-        a = (j.T @ j).tocsc() + scipy.sparse.diags(mu * diag[idx], format="csc")
-        step[idx] = -scipy.sparse.linalg.splu(a, permc_spec="COLAMD").solve(g[idx])
-        return step
-
-    def product(self, s: np.ndarray) -> np.ndarray:
-        return np.asarray(self.matrix @ s).ravel()
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.product(s)
-        return float(v @ v)
-
-
-@attrs.frozen
-class BlockArrowJacobian:
-    """Jacobian of residuals ``r = [r_1; ...; r_F]`` (``r_f``: m each) in ``x = [q_1 .. q_F, p]``
-    where ``r_f`` depends on ``q_f`` (n each) and ``p`` (k) only.
-
-    ``dq`` ``(F, m, n)`` = dr_f/dq_f; ``dp`` ``(F, m, k)`` = dr_f/dp.
-    """
-
-    dq: np.ndarray = attrs.field(converter=np.ascontiguousarray)
-    dp: np.ndarray = attrs.field(converter=np.ascontiguousarray)
-
-    @property
-    def shape(self) -> tuple[int, int, int, int]:
-        f, m, n = self.dq.shape
-        return f, m, n, self.dp.shape[2]
-
-    def gradient(self, r: np.ndarray) -> np.ndarray:
-        f, m, n, k = self.shape
-        rr = r.reshape(f, m)
-        return np.concatenate([np.einsum("fmn,fm->fn", self.dq, rr).ravel(), np.einsum("fmk,fm->k", self.dp, rr)])
-
-    def normal_diagonal(self) -> np.ndarray:
-        return np.concatenate([np.einsum("fmn,fmn->fn", self.dq, self.dq).ravel(),
-                               np.einsum("fmk,fmk->k", self.dp, self.dp)])
-
-    def damped_step(self, g: np.ndarray, free: np.ndarray, mu: float, diag: np.ndarray) -> np.ndarray:
-        f, m, n, k = self.shape
-        free_q = free[: f * n].reshape(f, n).astype(float)
-        free_p = free[f * n:].astype(float)
-        # stacked small products (one per frame): BLAS stays single-threaded at these sizes,
-        # which is much faster than one large threaded product on a busy machine
-        dq = self.dq * free_q[:, None, :]
-        dp = self.dp * free_p[None, None, :]
-        dq_t = dq.transpose(0, 2, 1)
-        a = dq_t @ dq
-        b = dq_t @ dp
-        c = (dp.transpose(0, 2, 1) @ dp).sum(axis=0)
-        dq_diag = (mu * diag[: f * n].reshape(f, n)) * free_q + (1.0 - free_q)
-        a[:, np.arange(n), np.arange(n)] += dq_diag
-        c[np.arange(k), np.arange(k)] += mu * diag[f * n:] * free_p + (1.0 - free_p)
-        gq = g[: f * n].reshape(f, n) * free_q
-        gp = g[f * n:] * free_p
-        if k == 0:
-            return -np.linalg.solve(a, gq[:, :, None])[:, :, 0].ravel()
-        solved = np.linalg.solve(a, np.concatenate([b, gq[:, :, None]], axis=2))
-        x_b, y = solved[:, :, :k], solved[:, :, k]
-        b_t = b.transpose(0, 2, 1)
-        schur = c - (b_t @ x_b).sum(axis=0)
-        rhs = -gp + (b_t @ y[:, :, None]).sum(axis=0)[:, 0]
-        step_p = np.linalg.solve(schur, rhs)
-        step_q = -(y + x_b @ step_p)
-        return np.concatenate([step_q.ravel(), step_p]) * free
-
-    def product(self, s: np.ndarray) -> np.ndarray:
-        f, m, n, k = self.shape
-        v = np.einsum("fmn,fn->fm", self.dq, s[: f * n].reshape(f, n)) + np.einsum("fmk,k->fm", self.dp, s[f * n:])
-        return v.ravel()
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.product(s)
-        return float(v @ v)
+if TYPE_CHECKING:
+    from nmsm.core.problem import OptimizationProblem
 
 
 #: damping of the Gauss-Newton step that tests the function tolerance (relative to diag(J^T J))
@@ -359,3 +221,77 @@ def solve(fun: ResidualJacobian, x0: np.ndarray, lower: Any = -np.inf, upper: An
     return LeastSquaresResult(x=x, residuals=r, cost=cost, iterations=iteration, evaluations=evaluations,
                               converged=converged, status=status, gradient_norm=pg_norm,
                               history=ConvergenceHistory(costs, optimality=gradients) if costs else None)
+
+
+class OptimizationResiduals(ResidualProblem):
+    """The weighted residuals of an :class:`~nmsm.core.problem.OptimizationProblem` (bounds
+    only) as a :class:`~nmsm.core.residual_problem.ResidualProblem` in its scaled variables,
+    with a :class:`~nmsm.core.jacobians.SparseJacobian`."""
+
+    def __init__(self, problem: OptimizationProblem) -> None:
+        if problem.constraints:
+            names = ", ".join(c.name for c in problem.constraints[:5])
+            raise ValueError(f"problem '{problem.name}' has constraints ({names}); the levenberg_marquardt back end "
+                             "handles bounds only: use backend='ipopt'")
+        problem.require_no_lifted_parameters("levenberg_marquardt")
+        self.problem = problem
+        self.name = problem.name
+        xs, ps = problem.scaled_vector(), problem.parameter_vector()
+        r = problem.residual_vector()
+        self._residuals = cs.Function("residuals", [xs, ps], [r])
+        self._jacobian = SparseOutput(cs.Function("jacobian", [xs, ps], [cs.jacobian(r, xs)]))
+        self._p = problem.parameter_values()
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.problem.bounds_scaled()
+
+    def evaluate(self, x: np.ndarray) -> tuple[np.ndarray, Jacobian]:
+        r = np.asarray(self._residuals(x, self._p)).ravel()
+        return r, SparseJacobian(self._jacobian(x, self._p))
+
+    def values(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        return self.problem.unpack(x)
+
+    def costs(self, x: np.ndarray) -> dict[str, float]:
+        return self.problem.term_costs(x)
+
+
+class LevenbergMarquardtBackend(Backend):
+    """Bound-constrained Levenberg-Marquardt with exact Jacobians (module docstring), on a
+    :class:`~nmsm.core.residual_problem.ResidualProblem` or an
+    :class:`~nmsm.core.problem.OptimizationProblem` with bounds only.
+
+    Options: the stopping rules of :class:`Tolerances` (``xtol``, ``ftol``, ``gtol``, ``ctol``,
+    ``max_iterations``, ``max_evaluations``), ``initial_guess`` (the start ``x`` (n,); required
+    for a ``ResidualProblem``, the scaled initial values of an ``OptimizationProblem`` by
+    default) and ``callback(iteration, cost, x)`` after every accepted iteration. The
+    :class:`~nmsm.core.solution.Solution`'s ``cost`` is ``sum(r**2)``, ``iterations`` the
+    iterations, ``evaluations`` the residual and Jacobian evaluations.
+    """
+
+    type: ClassVar[str] = "levenberg_marquardt"
+
+    def solve(self, problem: ResidualProblem | OptimizationProblem, *, initial_guess: np.ndarray | None = None,
+              callback: Callable[[int, float, np.ndarray], None] | None = None, **tolerances: Any) -> Solution:
+        try:
+            limits = Tolerances(**tolerances)
+        except TypeError as exc:
+            fields = ", ".join(a.name for a in attrs.fields(Tolerances))
+            raise TypeError(f"unknown levenberg_marquardt options: {', '.join(tolerances)} (expected {fields}, "
+                            "initial_guess, callback)") from exc
+        if isinstance(problem, ResidualProblem):
+            residuals = problem
+            if initial_guess is None:
+                raise TypeError(f"problem '{problem.name}': a ResidualProblem is solved from initial_guess=x0 (n,)")
+        else:
+            residuals = OptimizationResiduals(problem)
+            if initial_guess is None:
+                initial_guess = problem.initial_scaled()
+        lower, upper = residuals.bounds()
+        start = time.perf_counter()
+        result = solve(residuals.evaluate, np.asarray(initial_guess, dtype=float), lower, upper, limits, callback)
+        wall = time.perf_counter() - start
+        return Solution(values=residuals.values(result.x), cost=result.cost, term_costs=residuals.costs(result.x),
+                        success=result.converged, status=result.status, iterations=result.iterations,
+                        wall_time=wall, backend=self.type, x_scaled=result.x, history=result.history,
+                        evaluations=result.evaluations)
