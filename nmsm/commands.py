@@ -28,12 +28,13 @@ def _run(args: argparse.Namespace) -> int:
 def _plugins(args: argparse.Namespace) -> int:
     """The registered classes; then one line per plugin problem (exit status 1 if any), so a
     broken plugin does not hide the others."""
-    from nmsm.core.registry import inspect_plugins
+    from nmsm.core.registry import TOOL_NAMES, inspect_plugins
 
     report = inspect_plugins()
     items = report.registry.items(kind=args.kind)
     rows = [("KIND", "NAME", "TOOLS", "DISTRIBUTION", "VERSION")]
-    rows += [(it.kind, it.name, ",".join(sorted(it.tools)), it.distribution, it.version) for it in items]
+    rows += [(it.kind, it.name, "all" if it.tools >= set(TOOL_NAMES) else ",".join(sorted(it.tools)), it.distribution,
+              it.version) for it in items]
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
     if report.problems:

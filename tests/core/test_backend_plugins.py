@@ -99,3 +99,17 @@ def test_pyproject_names_every_builtin_plugin() -> None:
 
     declared = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["entry-points"]["nmsm"]
     assert declared == BUILTIN_PLUGINS
+
+
+def test_a_builtin_plugin_missing_from_an_older_install_is_loaded() -> None:
+    """An editable install made before a built-in plugin module was added names fewer entry
+    points than BUILTIN_PLUGINS: the missing modules are loaded as nmsm's own all the same."""
+    from nmsm.core.registry import PluginSource, _builtins_missing_from
+
+    old = [PluginSource(name, value, "nmsm", "0.1.0", lambda: None) for name, value in BUILTIN_PLUGINS.items()
+           if name != "builtin_backends"]
+    (added,) = _builtins_missing_from(old)
+    assert (added.name, added.value, added.distribution, added.is_nmsm) == ("builtin_backends",
+                                                                            "nmsm.core.backends.builtin", "nmsm", True)
+    assert added.load().__name__ == "nmsm.core.backends.builtin"
+    assert _builtins_missing_from(old + [added]) == [] and _builtins_missing_from([]) == []
