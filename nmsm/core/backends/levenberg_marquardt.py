@@ -273,12 +273,12 @@ class LevenbergMarquardtBackend(Backend):
 
     def solve(self, problem: ResidualProblem | OptimizationProblem, *, initial_guess: np.ndarray | None = None,
               callback: Callable[[int, float, np.ndarray], None] | None = None, **tolerances: Any) -> Solution:
-        try:
-            limits = Tolerances(**tolerances)
-        except TypeError as exc:
-            fields = ", ".join(a.name for a in attrs.fields(Tolerances))
-            raise TypeError(f"unknown levenberg_marquardt options: {', '.join(tolerances)} (expected {fields}, "
-                            "initial_guess, callback)") from exc
+        fields = [a.name for a in attrs.fields(Tolerances)]
+        unknown = [name for name in tolerances if name not in fields]
+        if unknown:
+            raise TypeError(f"unknown levenberg_marquardt options: {', '.join(unknown)} (expected {', '.join(fields)}, "
+                            "initial_guess, callback)")
+        limits = Tolerances(**tolerances)
         if isinstance(problem, ResidualProblem):
             residuals = problem
             if initial_guess is None:
