@@ -17,8 +17,8 @@ from nmsm.errors import RegistryError
 class Backend:
     """A solver of optimization problems, chosen by name.
 
-    ``type`` is its name; ``tools`` the tool codes it serves (every tool unless a subclass
-    narrows it: a back end is chosen by the tool's code, not by settings). :meth:`solve`
+    ``type`` is its name, by which code chooses it (settings files do not); ``tools`` is every
+    tool code, since a back end is found by name alone, whatever the tool. :meth:`solve`
     takes the problem and the back end's options as keywords and returns a
     :class:`~nmsm.core.solution.Solution`. Which problems a back end accepts is its own
     business: the built-in ones take an :class:`~nmsm.core.problem.OptimizationProblem`,
