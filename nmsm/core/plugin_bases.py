@@ -203,6 +203,23 @@ class ContactModel:
 
         return _np.zeros((1, 0))
 
+    #: True when :meth:`bind_model_parameters` is implemented: the contact follows a
+    #: parametric model (joint-frame model functions of Design Optimization)
+    follows_model_parameters: ClassVar[bool] = False
+
+    def belt_speed(self) -> Any | None:
+        """Speed (m/s; a number or an MX) of the treadmill belt under this contact, or None
+        when the contact model has no belt."""
+        return None
+
+    def set_belt_speed(self, value: Any) -> None:
+        """Make the belt speed ``value`` (m/s; a number or an MX, e.g. a design parameter)."""
+        raise NotImplementedError(f"{type(self).__name__} has no treadmill belt speed")
+
+    def bind_model_parameters(self, row: Any) -> None:
+        """Follow a parametric model: ``row`` (1, n_m) are its parameters' values (MX)."""
+        raise NotImplementedError(f"{type(self).__name__} cannot follow the model's parameters")
+
 
 class ModelModifier:
     """A Design Optimization model function: changes the model from static parameters.

@@ -27,10 +27,10 @@ class ApplyBeltSpeedParameter(ModelModifier):
         value = target.parameter(PARAMETER_TYPE)
         if value.numel() != 1:
             raise target.error(f"'{PARAMETER_TYPE}' needs one value, got {value.numel()}", element="<initial_values>")
-        surfaces = [c for c in target.contact_models if hasattr(c, "set_parameter")
+        surfaces = [c for c in target.contact_models if c.belt_speed() is not None
                     and (side not in ("true", "false") or c.is_left_foot == (side == "true"))]
         if not surfaces:
             raise target.error("no elastic-foundation contact surface for the belt speed (contact surfaces come "
                                "from the .osimx of Ground Contact Personalization)", element="<model_functions>")
         for contact in surfaces:
-            contact.set_parameter("belt_speed", value)
+            contact.set_belt_speed(value)

@@ -61,6 +61,14 @@ class ElasticFoundationContact(ContactModel):
                                  line=surface.line, element=exc.element, expected=exc.expected) from None
         return contacts
 
+    follows_model_parameters: ClassVar[bool] = True
+
+    def belt_speed(self) -> Any:
+        return self.values[CONTACT_PARAMETERS.index("belt_speed")]
+
+    def set_belt_speed(self, value: Any) -> None:
+        self.set_parameter("belt_speed", value)
+
     def set_parameter(self, name: str, value: Any) -> None:
         """Replace one of ``CONTACT_PARAMETERS`` (e.g. ``belt_speed``) by a value or MX."""
         self.values[CONTACT_PARAMETERS.index(name)] = value

@@ -335,10 +335,8 @@ class GridView:
     def belt_speed(self) -> Any:
         """Mean treadmill belt speed (m/s) of the contact surfaces that have one (0 if none);
         an MX when a model function (``applyBeltSpeedParameter``) made it a parameter."""
-        from nmsm.model.foot_contact import CONTACT_PARAMETERS
-
-        values = [c.values[CONTACT_PARAMETERS.index("belt_speed")] for c in self._q.data.contact_models
-                  if hasattr(c, "set_parameter") and hasattr(c, "values")]
+        speeds = (c.belt_speed() for c in self._q.data.contact_models)
+        values = [v for v in speeds if v is not None]
         if not values:
             return 0.0
         return sum((cs.MX(v) for v in values), cs.MX(0)) / len(values)

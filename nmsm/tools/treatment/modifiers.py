@@ -114,7 +114,7 @@ class ModificationTarget:
         model = self.data.model
         if not isinstance(model, OsimTreatmentModel):
             raise self.error("joint-frame model functions need an .osim model", element="<input_model_file>")
-        fixed = [c.name for c in self.data.contact_models if not hasattr(c, "bind_model_parameters")]
+        fixed = [c.name for c in self.data.contact_models if not c.follows_model_parameters]
         if fixed:
             raise self.error(f"contact model(s) {', '.join(fixed)} cannot follow a joint-frame model function",
                              element="<model_functions>",

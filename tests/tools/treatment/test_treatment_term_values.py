@@ -725,12 +725,16 @@ class _Target:
 
 
 class _Surface:
+    """A contact model with a treadmill belt (the ContactModel belt-speed methods)."""
+
     def __init__(self, left: bool) -> None:
         self.is_left_foot = left
         self.belt: Any = None
 
-    def set_parameter(self, name: str, value: Any) -> None:
-        assert name == "belt_speed"
+    def belt_speed(self) -> Any:
+        return 0.0 if self.belt is None else self.belt  # None: not set by the model function
+
+    def set_belt_speed(self, value: Any) -> None:
         self.belt = float(value)
 
 
@@ -957,16 +961,16 @@ def test_belt_speed_is_the_mean_over_the_surfaces_that_have_one() -> None:
 
     import casadi as cs
 
-    from nmsm.model.foot_contact import CONTACT_PARAMETERS
     from nmsm.tools.treatment.context import GridView
 
     def surface(speed: float) -> SimpleNamespace:
-        values = [0.0] * len(CONTACT_PARAMETERS)
-        values[CONTACT_PARAMETERS.index("belt_speed")] = speed
-        return SimpleNamespace(values=values, set_parameter=lambda *a: None)
+        return SimpleNamespace(belt_speed=lambda: speed)
 
-    contacts = [surface(1.2), SimpleNamespace(name="sphere"), surface(1.6)]
+    def sphere() -> SimpleNamespace:
+        return SimpleNamespace(name="sphere", belt_speed=lambda: None)
+
+    contacts = [surface(1.2), sphere(), surface(1.6)]
     view = SimpleNamespace(_q=SimpleNamespace(data=SimpleNamespace(contact_models=contacts)))
     assert float(cs.evalf(GridView.belt_speed(view))) == pytest.approx(1.4, rel=1e-14)
-    view._q.data.contact_models = [SimpleNamespace(name="sphere")]
+    view._q.data.contact_models = [sphere()]
     assert GridView.belt_speed(view) == 0.0
