@@ -83,7 +83,7 @@ class MtpData:
     ``stride``: EMG splines through every ``stride``-th sample. The original splines every
     sample on its EMG-only path but every 4th on its SynX path; one stride for both keeps
     the two paths consistent (zero SynX residuals give identical activations) and makes
-    the delayed spline 3 times cheaper. ``clip_smoothing``: see :data:`DEFAULT_CLIP_SMOOTHING`.
+    the delayed spline cheaper. ``clip_smoothing``: see :data:`DEFAULT_CLIP_SMOOTHING`.
     """
 
     muscles: MuscleParameters
