@@ -3,8 +3,8 @@
 The specification of the original MATLAB tools that nmsm was written from is not shipped with
 nmsm, so a comment citing it (``tools.md §6.3``, ``catalog §1.4``, ``spec pitfall``) leads
 nowhere. References go to our own docs (``docs/<tool>.md``, ``docs/terms.md``) or to the
-original's public code and paper (docs/architecture.md). Dates and history belong in
-docs/developing.md, not in code comments (docs/developing.md, "Audit trail").
+original's public code and paper (docs/architecture.md). Dates, history and measurements
+belong in docs/developing.md, not in code comments (docs/developing.md, "Audit trail").
 """
 
 from __future__ import annotations
@@ -25,6 +25,9 @@ UNSHIPPED_SPEC = re.compile(
 )
 #: a calendar date (2026-11-25) in a comment or docstring: history, which goes to docs/developing.md
 DATE = re.compile(r"\b20\d\d-[01]\d-[0-3]\d\b")
+#: a measurement told in a comment or docstring ("Measured on ...", "3.1 s instead of 4.2 s",
+#: "Patient 3: 482 iterations", a load average): measurements go to docs/developing.md
+MEASUREMENT = re.compile(r"\bMeasured\b|\bmeasured (on|with) (the|a|CasADi)\b|\binstead of \d|\bload average|\bPatient 3:")
 
 
 def _relative(path: pathlib.Path) -> str:
@@ -49,6 +52,8 @@ def test_the_scan_sees_the_package():
     assert UNSHIPPED_SPEC.search("GCP's contact model (spec tools.md §6.3)")
     assert UNSHIPPED_SPEC.search("(catalog §1.4)") and UNSHIPPED_SPEC.search("a change of velocity; spec pitfall")
     assert not UNSHIPPED_SPEC.search("(docs/gcp.md, 'Outputs')") and not UNSHIPPED_SPEC.search("spec.element")
+    assert MEASUREMENT.search("Measured on the 2-core machine") and MEASUREMENT.search("0.7 s instead of 3.2 s")
+    assert not MEASUREMENT.search("Accuracy is measured on held-out poses")
     assert DATE.search("# measured 2026-11-25") and not DATE.search("# 0.2026 s")
     assert _comments_and_docstrings('"""Doc."""\nx = 1  # note\n') == [(2, "# note"), (1, "Doc.")]
 
@@ -64,3 +69,9 @@ def test_no_dates_in_comments():
     hits = [f"{_relative(path)}:{line}: {DATE.search(text).group()}" for path in SOURCES
             for line, text in _comments_and_docstrings(path.read_text(encoding="utf-8")) if DATE.search(text)]
     assert not hits, "dated comments (history goes to docs/developing.md):\n" + "\n".join(hits)
+
+
+def test_no_measurements_in_comments():
+    hits = [f"{_relative(path)}:{line}: {MEASUREMENT.search(text).group()}" for path in SOURCES
+            for line, text in _comments_and_docstrings(path.read_text(encoding="utf-8")) if MEASUREMENT.search(text)]
+    assert not hits, "measurements in comments (they go to docs/developing.md):\n" + "\n".join(hits)
