@@ -4,6 +4,11 @@ Personalize an OpenSim model (joints, muscle-tendon properties, neural control, 
 contact) from one patient's lab data, then predict and optimize treatment by direct
 collocation. Derivatives come from CasADi automatic differentiation.
 
+"The original" in nmsm's comments is the MATLAB NMSM Pipeline: its source is
+https://github.com/rcnl-org/nmsm-core, its description the NMSM Pipeline paper
+(J. NeuroEngineering Rehabil. 2025, https://doi.org/10.1186/s12984-025-01629-5);
+``docs/`` (docs/architecture.md first) says what nmsm's code does.
+
 This module imports neither CasADi nor OpenSim, so the OpenSim bridge's worker process
 can import nmsm's plain-Python parts (see :mod:`nmsm.opensim_bridge`).
 """

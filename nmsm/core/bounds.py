@@ -1,4 +1,4 @@
-"""Variable bounds from data ranges (spec tools.md §8.2).
+"""Variable bounds from data ranges (docs/treatment.md, 'Formulation').
 
 For a signal ``x`` (tracked joint angles, speeds, accelerations; tracked ID loads for
 torque controls) the bounds are ``[min x - R, max x + R]`` with

@@ -531,7 +531,7 @@ def build_terms(specs: list[TermSpec], tool: str, *, registry: Any = None) -> li
         tag = "RCNLCostTerm" if spec.kind == "cost" else "RCNLConstraintTerm"
         where = _location(spec.source.file, spec.source.line)
         text = spec.fields.get("is_enabled")
-        if text is None or not text.strip():  # the original's default: false (spec settings-xml.md)
+        if text is None or not text.strip():  # the original's default: false
             state = "has no <is_enabled>" if text is None else "has an empty <is_enabled>"
             warnings.warn(f"{where}<{tag}> '{spec.type}' {state}: not used "
                           f"(write <is_enabled>true</is_enabled>)", stacklevel=2)

@@ -54,7 +54,7 @@ class TermContext(Protocol):
         """``(expression, lower, upper)`` for the problem's constraint vector."""
 
 
-#: ``*_list`` settings elements split into one term per item (tools.md / catalog §1.1).
+#: ``*_list`` settings elements split into one term per item (as the original).
 LIST_TO_SINGULAR: dict[str, str] = {
     "coordinate_list": "coordinate",
     "load_list": "load",

@@ -21,8 +21,8 @@ def _threads() -> int:
 
 #: threads of parallel CasADi evaluations (``map`` with ``thread`` parallelization): two
 #: where the machine has two or more cores, unless :data:`THREADS_VARIABLE` says otherwise.
-#: Measured on the 2-core CI machine (docs/mtp.md, docs/treatment.md); MUMPS's BLAS threads
-#: share the same cores, so more is not used without a measurement.
+#: MUMPS's BLAS threads share the same cores, so more are not used (the measurements behind
+#: two are in docs/developing.md).
 SOLVER_THREADS = _threads()
 
 
@@ -35,8 +35,8 @@ def thread_map(function: cs.Function, n: int, *, shared: Collection[int] = (), t
     keep ``function``'s size and are used by every evaluation; each output stacks the ``n``
     evaluations' outputs side by side. The same signature as
     ``function.map(name, "thread", n, shared, [])``, but that form starts one thread per
-    evaluation at every call (its ``max_num_threads`` option is not applied; measured with
-    CasADi 3.7: 101 threads per call of a 101-frame map), where this one starts ``threads``
+    evaluation at every call (its ``max_num_threads`` option is not applied; docs/developing.md,
+    "GCP"), where this one starts ``threads``
     threads, each evaluating a contiguous share of the columns.
     """
     shared = set(shared)

@@ -1,7 +1,7 @@
 """The synthetic subject's passive trials: the leg moved slowly by an examiner, muscles relaxed.
 
 Muscle-Tendon Length Initialization (MTLI) fits optimal fiber and tendon slack lengths to
-passive joint moments (tools.md §3); the original's tutorial ships passive trials for this.
+passive joint moments (docs/mtp.md); the original's tutorial ships passive trials for this.
 Each trial here sweeps one coordinate at constant speed with the other two held, the hip,
 knee and ankle each at three settings of a neighbouring joint so that the one- and two-joint
 muscles stretch in different combinations:

@@ -21,12 +21,12 @@ from nmsm.examples.subject import EMG_LOW_PASS, GCP_WINDOW, GRF_NAME, SIMULATION
 #: the stages of the example, in order (``nmsm example <stage>`` runs up to one of them)
 STAGES = ("jmp", "passive", "analysis", "preprocess", "mtp", "ncp", "gcp", "surrogate", "to", "vo", "do")
 PREPROCESSED_TRIAL = f"{TRIAL}_1"
-#: EMG padding (s) before and after the trial: the padded EMG starts at -0.14 s, before the
-#: simulation, where the recorded excitations are constant. MTP samples the EMG spline at
+#: EMG padding (s) before and after the trial: the padded EMG starts before the simulation,
+#: where the recorded excitations are constant. MTP samples the EMG spline at
 #: ``t - delay`` from the first padded frame on, so for the first ``delay`` seconds it
 #: extrapolates the spline's first cubic piece (as the original's ``ppval`` does); on a
 #: steep envelope that gives large negative excitations, and the activation dynamics
-#: (``(c1 e + c2) < 0``) amplify them into a transient that outlasts a 0.2 s padding
+#: (``(c1 e + c2) < 0``) amplify them into a transient that outlasts a shorter padding
 #: (docs/pipeline.md, "The built-in example").
 EMG_PADDING = 0.35
 
@@ -102,8 +102,7 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
     """MTLI fits the optimal fiber and tendon slack lengths to the passive trials; the MTP
     tasks then keep them and personalize delays, time constants, EMG scales and
     nonlinearities. (With the lengths free, one gait trial's moments trade them off against
-    the EMG scales: lengths 0.6-32 % off the truth and activations 0.039 RMS from it, against
-    0.022 with MTLI's lengths; docs/pipeline.md.)"""
+    the EMG scales; docs/developing.md, "Pipeline: measurements and audit trail".)"""
     channels = " ".join(spec.channel for spec in sm.MUSCLES.values())
     terms = _term("inverse_dynamics_joint_moment", 1.0)
     return f"""<MuscleTendonPersonalizationTool>
@@ -145,9 +144,9 @@ def mtp_xml(subject: Subject, folder: Path) -> str:
 
 
 def ncp_xml(subject: Subject, folder: Path, n_synergies: int) -> str:
-    """The NCP stage: 5 synergies of 8 muscles leave the weights nearly free, and IPOPT takes
-    700-1300 iterations depending on the BLAS threads (a single-threaded batch worker takes the
-    most), hence ``max_iterations`` 3000."""
+    """The NCP stage: 5 synergies of 8 muscles leave the weights nearly free, so IPOPT takes
+    many iterations, more with fewer BLAS threads (docs/pipeline.md, "The built-in example"),
+    hence ``max_iterations`` 3000."""
     terms = _term("moment_tracking", 1.0) + _term("activation_tracking", 0.02)
     return f"""<NeuralControlPersonalizationTool>
         <results_directory>ncp</results_directory>
@@ -173,14 +172,14 @@ def gcp_xml(subject: Subject, folder: Path) -> str:
     markers = sm.FOOT_MARKERS
     # markers to 0.5 mm (the tutorials' 2 mm is for lab markers; these are noise-free): most
     # of the friction comes from slip slower than the latching velocity, where only mu_d x
-    # slip speed counts and the foot kinematics set that speed; at 2 mm the dynamic friction
-    # came out -10.3 %, at 1 mm -9.5 %, at 0.5 mm -8.0 % (docs/pipeline.md)
+    # slip speed counts and the foot kinematics set that speed; tighter marker tracking
+    # brings the dynamic friction closer to the truth (docs/developing.md, "Pipeline: measurements")
     terms = lambda v, h, m: (_term("marker_position", 0.0005) + _term("rotation", 0.01)  # noqa: E731
                              + _term("vertical_grf", v) + _term("horizontal_grf", h)
                              + _term("ground_reaction_moment", m)
                              # as the original's tutorial: neighbouring springs alike (N/m); without it
                              # the heel-to-toe stiffness profile trades off against the foot
-                             # kinematics (43 % RMS spring-constant error instead of 27 %)
+                             # kinematics (docs/developing.md, "Pipeline: measurements")
                              + _term("neighbor_spring_constant", 500))
     flags = ("<springConstants>true</springConstants><dampingFactor>true</dampingFactor>"
              "<dynamicFrictionCoefficient>true</dynamicFrictionCoefficient>"

@@ -1,4 +1,4 @@
-"""The tools' data-folder layout (tools.md §0.2) as the results-folder checks need it.
+"""The tools' data-folder layout (docs/guide.md, section 2) as the results-folder checks need it.
 
 A data folder holds one sub-folder per kind of trial table: ``IKData/<trial>.sto``,
 ``IDData``, ``EMGData``, ``GRFData`` and ``MAData/<trial>/``. Results must not be written

@@ -1,6 +1,6 @@
 """``.osimx`` files: NMSM's personalized quantities next to an ``.osim`` model.
 
-Structure (``/work/shared/spec/osimx.md``)::
+Structure (docs/pipeline.md, 'Reading .osimx files')::
 
     NMSMPipelineDocument @Version
       OsimxModel @name
@@ -391,7 +391,7 @@ class _Reader:
                     child,
                     "old ground-contact layout: the contact surface names a toe coordinate/joint instead of "
                     "the hindfoot body; re-run GCP to write a current .osimx",
-                    "<hindfoot_body> (osimx.md)",
+                    "<hindfoot_body>",
                 )
             if child.tag == "GCPSpringSet":
                 for member in self.members(child, "GCPSpring"):
@@ -407,7 +407,7 @@ class _Reader:
                 extra.append(_serialize(child))
         for key in _SURFACE_FIELDS:
             if key not in found:
-                raise self.error(element, f"contact surface lacks <{key}>", "every contact-surface field (osimx.md)")
+                raise self.error(element, f"contact surface lacks <{key}>", "every contact-surface field")
         return OsimxContactSurface(
             is_left_foot=self.boolean(found["is_left_foot"]),
             belt_speed=self.number(found["belt_speed"]),
@@ -474,7 +474,7 @@ class _Reader:
                     child,
                     "old ground-contact layout <RCNLGroundContact> (toe coordinate instead of hindfoot body); "
                     "re-run GCP to write a current .osimx",
-                    "<RCNLContactSurfaceSet> (osimx.md)",
+                    "<RCNLContactSurfaceSet>",
                 )
             elif child.tag == "RCNLSynergySet":
                 for member in self.members(child, "RCNLSynergy"):

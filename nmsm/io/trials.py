@@ -8,7 +8,7 @@ digit follows (``gait_1`` is not in ``gait_10.sto``), one starting with a digit 
 digit precedes (``1_gait`` is not in ``11_gait.sto``) (:func:`contains_trial`). Several
 candidates are an error listing them.
 
-Layout (tools.md §0.2): ``<data>/IKData/<prefix>.sto``, ``IDData/``, ``EMGData/``,
+Layout (docs/guide.md, section 2): ``<data>/IKData/<prefix>.sto``, ``IDData/``, ``EMGData/``,
 ``GRFData/``, ``MAData/<prefix>/<prefix>_..._Length.sto`` etc.
 """
 

@@ -2,7 +2,7 @@
 
 A contact surface is a set of springs fixed to the hindfoot and toes bodies. Given the
 springs' positions and velocities in ground (``(3, n)``, m and m/s; ground y is up), each
-spring ``j`` with stiffness ``K_j`` (N/m) pushes on its body with (tools.md §6.3):
+spring ``j`` with stiffness ``K_j`` (N/m) pushes on its body with (docs/gcp.md):
 
 * vertical force (N), with ``y = 0.7 tanh((h - L0)/0.7)`` the smoothly clamped height
   above the resting spring length ``L0`` (m) and ``lc(x) = log(cosh(x))``::

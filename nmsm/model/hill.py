@@ -115,7 +115,7 @@ OSIMX_TIME_CONSTANT_UNIT = 0.01
 
 def time_constants_from_osimx(value: float) -> tuple[float, float]:
     """``(τ_a, τ_d)`` in s of an ``.osimx`` ``activation_time_constant`` (units of 0.01 s):
-    ``τ_a = 0.01 value``, ``τ_d = 4 τ_a`` (the pipeline's activation dynamics, tools.md §0.4)."""
+    ``τ_a = 0.01 value``, ``τ_d = 4 τ_a`` (the NMSM Pipeline's activation dynamics, docs/model.md)."""
     tau = OSIMX_TIME_CONSTANT_UNIT * float(value)
     return tau, DEACTIVATION_RATIO * tau
 #: default maximum shortening velocity, optimal fiber lengths per second

@@ -1,4 +1,4 @@
-"""Muscle forces and joint moments of the muscle and synergy controllers (spec tools.md §0.4, §8.3-2).
+"""Muscle forces and joint moments of the muscle and synergy controllers (docs/model.md, docs/treatment.md).
 
 Geometry comes from a fitted surrogate (:mod:`nmsm.model.surrogate`: lengths, velocities
 and moment arms as polynomials of the surrogate coordinates); forces from the rigid-tendon

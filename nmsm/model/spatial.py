@@ -9,17 +9,8 @@ import casadi as cs
 import numpy as np
 
 
-def skew(v: Any) -> Any:
-    """The cross-product matrix of a 3-vector: ``skew(a) @ b == a x b``."""
-    return cs.vertcat(
-        cs.horzcat(0, -v[2], v[1]),
-        cs.horzcat(v[2], 0, -v[0]),
-        cs.horzcat(-v[1], v[0], 0),
-    )
-
-
 def vee(m: Any) -> Any:
-    """The vector of a (nearly) skew matrix (inverse of :func:`skew`)."""
+    """The vector ``a`` of a (nearly) skew-symmetric matrix ``m``, with ``m @ b ≈ a x b``."""
     return cs.vertcat(m[2, 1], m[0, 2], m[1, 0])
 
 

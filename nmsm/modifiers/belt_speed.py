@@ -2,7 +2,7 @@
 
 Parameter term type ``belt_speed`` (m/s), one value; ``<is_left_foot>`` (true/false) picks the
 contact surfaces of that foot (absent: every surface). The elastic-foundation contact models'
-friction uses the parameter as belt speed (tools.md §6.3), e.g. to find the speed a patient
+friction uses the parameter as belt speed (docs/gcp.md), e.g. to find the speed a patient
 walks best at.
 """
 

@@ -25,7 +25,8 @@ contact follow the moved frame with exact derivatives
 (:meth:`~nmsm.tools.treatment.modifiers.ModificationTarget.set_joint_frame`); tracked data keep
 the file's model. Not with muscle-driven controllers (their muscle geometry is the file's).
 Values are absolute; the solved model is written as ``<model>DesignOpt.osim``. The original
-has no such built-in (tools.md §11.1 lists muscle and belt-speed parameters).
+has no such built-in (its Design Optimization's model parameters are muscle and belt-speed
+parameters).
 """
 
 from __future__ import annotations

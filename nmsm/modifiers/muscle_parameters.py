@@ -11,7 +11,7 @@ give one value per muscle or one value shared by all listed muscles.
                                        (a muscle's strength, e.g. weakness after stroke)
 
 (The original's built-in ``apply*Parameter`` functions read the wrong field and cannot run
-as model functions - tools.md §11.1; these do what they intend.)
+as model functions; these do what they intend.)
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """``synergy_weight_sum``: each synergy vector of a group sums to a constant (NCP).
 
-tools.md §5: the weights of every synergy vector of group ``g`` sum to ``M_g / 100``
+docs/ncp.md: the weights of every synergy vector of group ``g`` sum to ``M_g / 100``
 (``M_g`` muscles in the group), which removes the scale ambiguity between vectors and
 commands. NCP adds one of these per group whose vectors are design variables; it is not
 declared in settings.

@@ -1,4 +1,4 @@
-"""Centre-of-pressure path constraints (catalog §1.4; contact models, TO and DO, not VO).
+"""Centre-of-pressure path constraints (docs/terms.md; contact models, TO and DO, not VO).
 
 ``center_of_pressure_deviation``  CoP - CoP_exp of one foot on one floor axis (m)
 ``center_of_pressure_value``      CoP (m)

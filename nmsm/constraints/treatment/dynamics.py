@@ -1,4 +1,4 @@
-"""Physics constraints of the implicit formulation (catalog §1.4), path constraints.
+"""Physics constraints of the implicit formulation (docs/terms.md), path constraints.
 
 ``kinetic_consistency``        τ_ID(load) - (muscle moments + torque controls on the load's
                                coordinate), N·m or N: the controllers must produce the loads the

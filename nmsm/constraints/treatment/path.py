@@ -1,4 +1,4 @@
-"""Path constraints on kinematic signals, controls and muscles (catalog §1.4).
+"""Path constraints on kinematic signals, controls and muscles (docs/terms.md).
 
 ``<family>_deviation`` = modeled - tracked, ``<family>_value`` = modeled, at every collocation
 point, bounded by ``[min_error, max_error]``. Families: ``generalized_coordinate``,

@@ -1,4 +1,4 @@
-"""Synergy vector constraints (catalog §1.4, terminal; synergy controller, TO/DO).
+"""Synergy vector constraints (docs/terms.md; terminal; synergy controller, TO/DO).
 
 ``synergy_vector_sum``       Σ_j w_sj of synergy ``<synergy>`` (``<group>_<k>``)
 ``synergy_vector_magnitude`` ‖w_s‖₂

@@ -1,4 +1,4 @@
-"""Terminal constraints (catalog §1.4): values at the movement's start (t0) and end (t_f).
+"""Terminal constraints (docs/terms.md): values at the movement's start (t0) and end (t_f).
 
 For each family - ``generalized_coordinate``, ``generalized_speed``, ``marker_position``,
 ``marker_velocity``, ``body_orientation``, ``external_force``, ``external_moment`` - five types:
@@ -10,7 +10,7 @@ For each family - ``generalized_coordinate``, ``generalized_speed``, ``marker_po
 ``final_<family>_value``        modeled(t_f)
 
 plus ``root_segment_residual_load_periodicity`` (τ_ID(t_f) - τ_ID(t0) of a load; uses the
-real end accelerations, unlike the original, see tools.md §8.2). Each is bounded by
+real end accelerations, unlike the original, see docs/treatment.md). Each is bounded by
 ``[min_error, max_error]``. Periodicity of generalized coordinates is only accepted for
 state coordinates (prescribed ones follow the data). Units: those of the family.
 

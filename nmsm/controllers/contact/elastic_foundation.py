@@ -1,4 +1,4 @@
-"""GCP's elastic-foundation foot contact (spec tools.md §6.3) as a Treatment Optimization contact model.
+"""GCP's elastic-foundation foot contact (docs/gcp.md) as a Treatment Optimization contact model.
 
 One instance per ``RCNLContactSurface`` of the ``.osimx`` (springs on the hindfoot and toes
 bodies, from Ground Contact Personalization). Loads go to the hindfoot and toes bodies; the

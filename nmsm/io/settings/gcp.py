@@ -16,7 +16,7 @@ TOOL_ELEMENT = "GroundContactPersonalizationTool"
 
 _GCP_TERMS = ({"is_enabled": "true", "type": "vertical_grf", "max_allowable_error": "5"},)
 
-#: design-variable flags of a GCP task, in the order of tools.md §6.5
+#: design-variable flags of a GCP task, in the original's order
 DESIGN_FLAGS = (
     "springConstants",
     "dampingFactor",

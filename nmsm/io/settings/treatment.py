@@ -303,7 +303,7 @@ class TreatmentOptimizationSettings:
         empty_is_base=True,
         default=None,
         example="preprocessed",
-        doc="Initial guess: IKData, IDData, <trial>_states.sto, ... (tools.md 8.1)",
+        doc="Initial guess: IKData, IDData, <trial>_states.sto, ...",
     )
     tracked_quantities_directory: Path = setting(
         "tracked_quantities_directory",

@@ -166,7 +166,7 @@ def _mtp(up: Upgrader, tool: etree._Element) -> None:
     if synx is not None:
         prefixes = child_of(synx, "task_prefixes")
         if prefixes is not None:
-            up.drop(prefixes, "no current equivalent in <MTPSynergyExtrapolation> (settings-xml.md section 2)")
+            up.drop(prefixes, "no current equivalent in <MTPSynergyExtrapolation>")
     _muscle_common(up, tool)
 
 

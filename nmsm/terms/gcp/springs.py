@@ -26,7 +26,7 @@ class NeighborSpringConstant(FootCostTerm):
     (weights ``exp(-d^2/(2 sigma^2))`` of the 3-D spring distances; sigma the task's
     ``neighborStandardDeviation``).
 
-    Non-standard normalization (catalog §5): the residual is ``((raw - c)/e)^4``, so
+    Non-standard normalization (as the original's GCP): the residual is ``((raw - c)/e)^4``, so
     deviations below ``e`` are nearly free and larger ones grow steeply.
     """
 

@@ -1,1 +1,1 @@
-"""Muscle-Tendon Length Initialization cost terms (``tools = {"MTLI"}``), catalog §3."""
+"""Muscle-Tendon Length Initialization cost terms (``tools = {"MTLI"}``), docs/terms.md."""

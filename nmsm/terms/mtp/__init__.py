@@ -1,1 +1,1 @@
-"""Muscle-Tendon Personalization cost terms (``tools = {"MTP"}``), catalog §2."""
+"""Muscle-Tendon Personalization cost terms (``tools = {"MTP"}``), docs/terms.md."""

@@ -1,6 +1,6 @@
 """``grouped_fiber_lengths``: activations similar within each normalized-fiber-length group.
 
-As in the MATLAB original (catalog §4), the deviation is computed on the **activations**
+As in the MATLAB original, the deviation is computed on the **activations**
 of the ``normalized_fiber_length_muscle_groups``: NCP's normalized fiber lengths are data
 (they do not depend on the design variables), so a deviation of fiber lengths would be a
 constant.

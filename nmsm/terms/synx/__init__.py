@@ -1,1 +1,1 @@
-"""Synergy Extrapolation cost terms of MTP (``tools = {"SynX"}``), catalog §2."""
+"""Synergy Extrapolation cost terms of MTP (``tools = {"SynX"}``), docs/terms.md."""

@@ -1,4 +1,4 @@
-"""``angular_momentum_minimization`` (DO; catalog §1.3, intended math of §6).
+"""``angular_momentum_minimization`` (DO; docs/terms.md, the intended math).
 
 Integrand component ``g = H_axis / t_f``: ``H`` is the whole-body angular momentum about the
 centre of mass in ground axes (kg·m²/s; ``Σ m_i (c_i - c) × (v_i - ċ) + I_i ω_i``), ``axis``

@@ -1,4 +1,4 @@
-"""Centre-of-pressure tracking (catalog §1.3; contact models, TO/DO).
+"""Centre-of-pressure tracking (docs/terms.md; contact models, TO/DO).
 
 ``center_of_pressure_tracking``   CoP - CoP_exp of one foot on one floor axis (``x`` or ``z``, m).
 The foot is named by its ``<hindfoot_body>`` (``<hindfoot_body_list>``): every contact model

@@ -1,4 +1,4 @@
-"""Controller costs (catalog §1.3). ``controller`` names a control of the problem's
+"""Controller costs (docs/terms.md). ``controller`` names a control of the problem's
 controllers: a torque-controlled coordinate (``c``, ``c_moment``), a synergy activation
 (``<group>_<k>``) or a muscle (individual activation controller).
 

@@ -1,4 +1,4 @@
-"""Ground reaction costs (catalog §1.3; contact models, TO/DO).
+"""Ground reaction costs (docs/terms.md; contact models, TO/DO).
 
 ``external_force_tracking``   F_exp - F of one force column (N) of a contact surface
 ``external_moment_tracking``  M_exp - M of one moment column (N·m), both about the surface's

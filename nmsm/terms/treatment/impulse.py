@@ -1,4 +1,4 @@
-"""Braking and propulsive impulse goals (DO, discrete; catalog §1.3).
+"""Braking and propulsive impulse goals (DO, discrete; docs/terms.md).
 
 ``propulsive_impulse_goal``  ``I = ∫ max(F_x, 0) dt`` of one foot (N·s)
 ``braking_impulse_goal``     ``I = ∫ max(-F_x, 0) dt``

@@ -1,4 +1,4 @@
-"""Inverse-dynamics load costs (catalog §1.3, §6). ``load`` is an ID label
+"""Inverse-dynamics load costs (docs/terms.md). ``load`` is an ID label
 (``<coordinate>_moment`` / ``<coordinate>_force``; a coordinate name is accepted too).
 
 ``inverse_dynamics_load_tracking``       scale·τ_exp - τ_ID            (N·m or N)
@@ -7,9 +7,9 @@
                                          between collocation points, last row 0)
 ``inverse_dynamics_shape_tracking``      τ_exp - k·τ_ID, k = (τ_ID·τ_exp)/(τ_ID·τ_ID) (DO;
                                          the original's version cannot run, this is the
-                                         intended math, catalog §6)
+                                         intended math)
 ``joint_energy_generation_goal``         P = τ_ID·q̇ of the load's coordinate (W); the integrand
-                                         is (max(P - c, 0)/e)² (DO, intended math of §6)
+                                         is (max(P - c, 0)/e)² (DO, the intended math)
 ``joint_energy_absorption_goal``         same with -P
 """
 

@@ -1,4 +1,4 @@
-"""Generalized coordinate, speed and acceleration costs (catalog §1.3).
+"""Generalized coordinate, speed and acceleration costs (docs/terms.md).
 
 ``generalized_coordinate_tracking``   q_exp - q      (rad or m)
 ``generalized_speed_tracking``        q̇_exp - q̇      (rad/s or m/s)

@@ -1,4 +1,4 @@
-"""Marker and body-orientation costs (catalog §1.3). ``<axes>`` splits into one term per axis.
+"""Marker and body-orientation costs (docs/terms.md). ``<axes>`` splits into one term per axis.
 
 ``marker_position_tracking``      p_exp - p on one axis (m), tracked = marker on the tracked IK
 ``marker_velocity_tracking``      ṗ_exp - ṗ (m/s)

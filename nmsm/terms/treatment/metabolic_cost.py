@@ -1,4 +1,5 @@
-"""Metabolic cost goals (DO, discrete; catalog §1.3, smoothed Bhargava model of tools.md §11.2).
+"""Metabolic cost goals (DO, discrete; docs/terms.md; the smoothed Bhargava model of
+:mod:`nmsm.tools.treatment.metabolics`).
 
 ``Ė(t)`` (W) is the whole-body metabolic rate of :meth:`TreatmentContext.metabolic_rate`
 (every muscle of the synergy / individual-muscle controllers plus the basal rate
@@ -15,8 +16,8 @@ plus the mean belt speed of the contact surfaces (m/s, 0 without a treadmill):
 Departure (units): the original divides its normalized-time integral of Ė (already the mean
 power) once more by ``t_f``; here the per-time cost is the mean power itself (W) and the
 per-distance cost energy per distance (J/m). Relative costs agree with the original when the
-final time is fixed. The original also computes Ė only when a ``relative_*`` type is enabled
-(spec pitfall); here every type triggers it.
+final time is fixed. The original also computes Ė only when a ``relative_*`` type is enabled;
+here every type triggers it.
 """
 
 from __future__ import annotations

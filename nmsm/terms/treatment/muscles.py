@@ -1,4 +1,4 @@
-"""Muscle activation costs (catalog §1.3); muscles driven by a synergy or muscle controller.
+"""Muscle activation costs (docs/terms.md); muscles driven by a synergy or muscle controller.
 
 ``muscle_activation_tracking``      scale·a_exp - a   (a_exp: ``<trial>_combinedActivations.sto``
                                     of the initial guess directory)

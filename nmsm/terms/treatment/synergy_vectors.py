@@ -1,4 +1,4 @@
-"""Synergy vector costs (catalog §1.3, discrete; synergy controller).
+"""Synergy vector costs (docs/terms.md; discrete; synergy controller).
 
 ``synergy_vector_tracking``  ‖w_s - w_s,init‖₂ over the group's muscles (the original does not
                              divide it by max_allowable_error; here it is normalized like every

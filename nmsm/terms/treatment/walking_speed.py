@@ -1,9 +1,9 @@
-"""``relative_walking_speed_goal`` (DO, discrete; catalog §1.3, tools.md §8.3-6).
+"""``relative_walking_speed_goal`` (DO, discrete; docs/terms.md, docs/treatment.md).
 
 ``v = (c_x(t_f) - c_x(0)) / t_f``: mean forward (ground x) speed of the whole-body centre of
 mass over the movement (m/s), relative to the model's ground (the belt, on a treadmill); the
 objective gets ``((v - c)/e)²``. The original computes ``(ċ_x(t_f) - ċ_x(0)) / t_f`` (a change
-of COM velocity, not a speed; spec pitfall), and only on Windows; this is the intended mean
+of COM velocity, not a speed), and only on Windows; this is the intended mean
 speed.
 """
 

@@ -1,5 +1,5 @@
 """Ground Contact Personalization (GCP): a personalized elastic-foundation foot contact model
-from ground reactions and foot kinematics (tools.md §6).
+from ground reactions and foot kinematics (docs/gcp.md).
 
 Entry point: :func:`nmsm.tools.gcp.run.run_settings` (``nmsm run`` dispatches
 ``<GroundContactPersonalizationTool>`` there). Modules, in the order a run uses them:
@@ -16,7 +16,7 @@ Entry point: :func:`nmsm.tools.gcp.run.run_settings` (``nmsm run`` dispatches
 ``problem``      one task as an ``OptimizationProblem`` with the foot coordinates lifted; solver
                  options (solved by the back end ``lifted_least_squares``)
 ``rest_length``  initial resting spring length
-``outputs``, ``write``, ``filtering``, ``ik_update``  result files (tools.md §6.7)
+``outputs``, ``write``, ``filtering``, ``ik_update``  result files (docs/gcp.md)
 ``report``       the RMS error table (Table 4 layout); ``compare`` scores finished results
 
 The contact model itself, shared with Treatment Optimization, is

@@ -1,7 +1,7 @@
 """B-spline matrices of evenly sampled curves and the node count matching a cutoff frequency.
 
 These reproduce the original pipeline's ``BSplineMatrices`` / ``calcBSplineDerivative`` /
-``splFitWithCutoff`` (tools.md §0.3):
+``splFitWithCutoff`` of the original:
 
 * :func:`bspline_matrices` - a clamped uniform B-spline of ``degree`` with ``nodes``
   control points evaluated on ``frames + 4`` samples ``interval`` apart (two padding

@@ -2,7 +2,7 @@
 
 :class:`GcpContext` holds every foot's :class:`~nmsm.tools.gcp.values.FootValues` and the
 design of the task. Terms ask it for raw per-foot quantities; each foot's block is reduced
-on its own as ``raw / (e sqrt(len(raw)))`` (catalog §5), i.e.
+on its own as ``raw / (e sqrt(len(raw)))`` (as the original's GCP), i.e.
 :func:`nmsm.core.reductions.mean_square` per block.
 
 Raw quantities (per foot, ``T`` frames; all modeled minus experimental):

@@ -4,7 +4,7 @@ reactions of each foot's force columns, on each foot's own time window.
 Time grids: the motion's frames inside ``[start_time, end_time]`` define the window; they
 must be evenly spaced (the kinematics are B-splines on equal increments). A window reaching
 beyond the motion warns and uses the motion's frames inside it. Each frame takes
-the ground-reaction row within 5 ms of it (tools.md §6.1). When the two files are sampled
+the ground-reaction row within 5 ms of it. When the two files are sampled
 differently (no such row), the ground reactions are linearly interpolated onto the motion
 frames, with a warning; when they do not cover the window, or the motion is unevenly
 sampled, :class:`~nmsm.errors.InputError` names the files and what was expected.

@@ -2,7 +2,7 @@
 
 The foot is the hindfoot body, the toes body and the toes joint between them (the one
 child joint of the hindfoot with one coordinate), moved by a six-coordinate joint to
-ground. Its coordinate vector (tools.md §6.1) is::
+ground. Its coordinate vector is::
 
     q = [toe, r1, r2, r3, tx, ty, tz]      (rad, rad, rad, rad, m, m, m)
 

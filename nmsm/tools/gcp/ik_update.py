@@ -1,6 +1,6 @@
 """The full-body motion updated to the optimized foot kinematics (``IKData/gcp_modeled_*``).
 
-As the original (tools.md §6.7): every model marker is placed where the input motion puts
+As the original: every model marker is placed where the input motion puts
 it, the foot markers of each personalized foot are replaced by their modeled positions,
 and inverse kinematics is re-run with weight 1000 on those foot markers and 1 on the
 others (nmsm's IK, :func:`nmsm.tools.jmp.ik.inverse_kinematics`); the coordinates are then

@@ -1,6 +1,6 @@
 """The ``neighbor_spring_constant`` deviation, computed from the toe angle.
 
-Per frame ``t`` and spring ``j`` (catalog §5)::
+Per frame ``t`` and spring ``j``::
 
     dev_jt = K_j - sum_k w_jkt K_k / sum_k w_jkt,   w_jkt = exp(-d_jkt^2 / (2 sigma^2)), k != j
 

@@ -1,4 +1,4 @@
-"""GCP result files (tools.md §6.7), written into a staging folder.
+"""GCP result files (docs/gcp.md, 'Outputs'), written into a staging folder.
 
 Per foot ``<n>`` (1-based), with ``<model>`` the input model's file stem:
 

@@ -1,6 +1,6 @@
 """One GCP task as an :class:`~nmsm.core.problem.OptimizationProblem`.
 
-The task's flags (tools.md §6.5) choose the design-variable blocks; everything else is
+The task's flags choose the design-variable blocks; everything else is
 held at the current :class:`~nmsm.tools.gcp.state.GcpState`. Variable names, bounds and
 scales:
 

@@ -1,4 +1,4 @@
-"""Initial resting spring length (``initialize_resting_spring_length``, tools.md §6.6).
+"""Initial resting spring length (``initialize_resting_spring_length`` of the original).
 
 Before the tasks, ``L0`` alone is fitted to the vertical ground reaction of every foot
 with everything else at its initial value (spring constants, damping, kinematic

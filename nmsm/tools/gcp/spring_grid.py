@@ -22,9 +22,9 @@ toes joint at 0, heights ignored):
    cover the whole sole from the heel to the toe marker. About 85 % of the grid is kept
    (5 x 11: 47 springs, 8 x 15: 106, 5 x 15: 65; the original's shoe outline keeps 37, 83
    and 55 and starts about 10 % of the foot length ahead of the heel marker; a tighter
-   outline of that kind gave worse fits of the tutorial in 20 iterations).
+   outline of that kind fitted the tutorial worse, docs/developing.md, "GCP: measurements").
 4. Height: every spring sits at ``y = -(hindfoot origin height in the model's default
-   pose)`` in the hindfoot frame (tools.md §6.2), i.e. on the floor in the default pose.
+   pose)`` in the hindfoot frame, i.e. on the floor in the default pose.
 5. Points beyond the toes joint axis (on the toe side of the axis line in the x-z plane)
    belong to the toes body and are expressed in its frame; the others to the hindfoot.
 

@@ -11,7 +11,7 @@ with numbers they are DM values (outputs, scoring). Shapes (``T`` frames, ``n`` 
 * ``experimental_forces``/``experimental_moments`` (3, T): the plate's reactions moved to
   the experimental midfoot point at the resting-spring-length height, plus
   ``shift x F`` for an electrical-center shift, then rotated about ground y by the plate
-  rotation ``theta`` (tools.md §6.4; nmsm uses the current ``theta``, not the previous
+  rotation ``theta`` (nmsm uses the current ``theta``, not the previous
   task's, so the derivative is exact).
 """
 

@@ -1,6 +1,6 @@
 """MTP input data: trials read from the personalization folder layout.
 
-Layout (tools.md §0.2)::
+Layout (docs/guide.md, section 2)::
 
     <data_directory>/IDData/<prefix>.sto          inverse-dynamics loads (N m), 101 rows typical
                      EMGData/<prefix>.sto         processed EMG, rows + 2 * padding

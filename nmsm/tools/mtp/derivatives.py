@@ -28,12 +28,11 @@ def blockwise_derivatives(problem: OptimizationProblem, *, gauss_newton: Sequenc
     ``H`` is the upper triangle (``triu``) of the symmetric Hessian, as CasADi's own
     ``nlp_hess_l`` returns it. Cost terms named in ``gauss_newton`` contribute their
     Gauss-Newton matrix ``2 w J^T J`` (``J`` their exact residual Jacobian) instead of their
-    exact Hessian; gradients and the solution's optimality are unchanged. (Measured for the
-    Synergy Extrapolation activation terms: their exact second derivatives dominate the
-    Hessian time on Patient 3 and Gauss-Newton is ~10 times cheaper per evaluation, but on
-    tutorial V1 IPOPT then stopped unconverged at 150 iterations instead of converging in
-    50, so ``nmsm run`` keeps the exact Hessian.) With ``threads`` > 1 the blocks of ``J``
-    and ``H`` are dealt round-robin into that many groups evaluated on parallel threads
+    exact Hessian; gradients and the solution's optimality are unchanged. (``nmsm run`` keeps
+    the exact Hessian: with Gauss-Newton for the Synergy Extrapolation activation terms IPOPT
+    stopped unconverged on a tutorial; docs/developing.md, "MTP: measurements".) With
+    ``threads`` > 1 the blocks of ``J`` and ``H`` are dealt round-robin into that many groups
+    evaluated on parallel threads
     (:func:`parallel_vertcat`, :func:`parallel_sum`).
     """
     x = problem.scaled_vector()

@@ -1,6 +1,6 @@
 """MTP's modeled quantities as CasADi expressions, one trial at a time.
 
-Chain per trial and muscle (tools.md §4.2, Meyer 2017):
+Chain per trial and muscle (docs/mtp.md, Meyer 2017):
 
 1. excitation ``e_k = S(t_k - EMD/10)``, ``S`` the not-a-knot spline of the (scaled)
    EMG samples (:mod:`nmsm.tools.mtp.emg_spline`), ``t_k`` evenly spaced over the EMG time;
@@ -59,7 +59,7 @@ class MuscleDesign:
 
     @staticmethod
     def initial(n_muscles: int) -> MuscleDesign:
-        """The original's initial values (tools.md §4.3)."""
+        """The original's initial values (docs/mtp.md)."""
         return MuscleDesign(
             electromechanical_delay=np.full(n_muscles, 0.5),
             activation_time_constant=np.full(n_muscles, 1.5),

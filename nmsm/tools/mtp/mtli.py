@@ -1,11 +1,11 @@
 """Muscle-Tendon Length Initialization (MTLI): least-squares fit of l_o, l_ts (and stress).
 
-Runs before MTP (and NCP) when enabled (tools.md §3). Residual vector of the enabled
+Runs before MTP (and NCP) when enabled (docs/mtp.md). Residual vector of the enabled
 terms, each ``(x - c) / (e sqrt(n))``; the original uses ``lsqnonlin`` (100 iterations).
 Here IPOPT minimizes the same sum of squares within the bounds with exact gradients and a
 Gauss-Newton Hessian (:func:`nmsm.tools.mtp.derivatives.gauss_newton_hessian`): scipy's
 least-squares needs an SVD of the (residuals x variables) Jacobian per iteration, which
-for 34 muscles (15 000 residuals) took seconds each.
+grows with the muscles and frames (docs/developing.md, "MTP: measurements").
 Result: new optimal fiber lengths, tendon slack lengths and (with
 ``optimize_isometric_max_force``) maximum isometric forces ``F0 = V / l_o * sigma0 * s_sigma``.
 """

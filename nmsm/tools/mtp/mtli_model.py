@@ -1,6 +1,6 @@
 """Muscle-Tendon Length Initialization (MTLI): modeled quantities and term context.
 
-Design variables (tools.md §3), as CasADi expressions:
+Design variables (docs/mtp.md), as CasADi expressions:
 
 * ``optimal_fiber_length``: scale factors ``s_o`` (init 1, [0.5, 2]) or absolute lengths
   (m, [0.001, 2]) when ``optimize_absolute_length_changes``;

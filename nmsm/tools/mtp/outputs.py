@@ -1,4 +1,4 @@
-"""MTP result files, as the original writes them (tools.md §4.6).
+"""MTP result files, as the original writes them (docs/mtp.md).
 
 Into a staging folder (:class:`nmsm.core.results.ResultsDirectory` moves it into place):
 

@@ -1,6 +1,6 @@
 """One MTP task as an :class:`~nmsm.core.problem.OptimizationProblem` (IPOPT).
 
-Design-variable blocks (tools.md §4.3), one value per muscle, included by the task's
+Design-variable blocks (docs/mtp.md), one value per muscle, included by the task's
 ``optimize_*`` flags (excluded blocks stay at their current values):
 
 ====================================  =========  ======  ==============
@@ -57,8 +57,7 @@ SYNERGY_WEIGHT_BOUNDS = (-100.0, 100.0)
 #: nmsm.model.hill.clip_negative): exact outside |x| < 0.01, at most 0.0019 above max(x, 0).
 #: The original clips hard, which stalls IPOPT when synergy extrapolation drives excitations
 #: below 0; a narrow smoothing (1e-4) leaves a near-kink of curvature ~1e4 that IPOPT crawls
-#: through (Patient 3: 482 iterations, 1269 s in IPOPT; with 0.01: 146 iterations, 297 s;
-#: docs/mtp.md).
+#: through (docs/developing.md, "MTP: measurements and audit trail").
 DEFAULT_CLIP_SMOOTHING = 1e-2
 #: soft-maximum sharpness and limits of the normalized-fiber-length constraints
 CONSTRAINT_SHARPNESS = 500.0
@@ -84,7 +83,7 @@ class MtpData:
     ``stride``: EMG splines through every ``stride``-th sample. The original splines every
     sample on its EMG-only path but every 4th on its SynX path; one stride for both keeps
     the two paths consistent (zero SynX residuals give identical activations) and makes
-    the delayed spline 3 times cheaper. ``clip_smoothing``: see :data:`DEFAULT_CLIP_SMOOTHING`.
+    the delayed spline cheaper. ``clip_smoothing``: see :data:`DEFAULT_CLIP_SMOOTHING`.
     """
 
     muscles: MuscleParameters
@@ -187,7 +186,7 @@ def extreme_fiber_lengths(models: Sequence[TrialModel], trials: Sequence[TrialDa
     With a rigid tendon and constant pennation ``l = (l_MT - l_ts) / (l_o cos alpha)``
     increases with ``l_MT`` for every design (``l_o > 0``), so bounding these two values is
     the same as bounding every frame's value: two rows per muscle instead of one per frame
-    (Patient 3: 68 instead of 13 736 constraint rows in IPOPT's linear systems).
+    and muscle in IPOPT's linear systems.
     """
     lengths = np.vstack([np.asarray(t.muscle_tendon_length, dtype=float) for t in trials])
     owner = np.concatenate([np.full(t.n_frames, k) for k, t in enumerate(trials)])
@@ -334,10 +333,8 @@ def _lift(
     need few colours (see :mod:`nmsm.tools.mtp.derivatives`), and the activation cost terms
     become quadratic in variables. Forces are scaled by each muscle's ``F0 cos(alpha)`` and
     moments by each coordinate's largest ID moment, variables and equality rows alike, so
-    all lifted quantities are O(1). (Lifting the activations cut Patient 3's Hessian from
-    1.19 s to 0.33 s per iteration and its benchmark IPOPT time from 297 s to 184 s,
-    docs/mtp.md; in the same experiment series, lifting activations but not forces took
-    264 s of IPOPT time where lifting both took 179 s.)
+    all lifted quantities are O(1). (What lifting saves is measured in docs/developing.md,
+    "MTP: measurements and audit trail".)
     """
     design = MuscleDesign(**{f: np.asarray(getattr(state.design, f), dtype=float) for f in BLOCKS})
     plain, synx = modeled_trials(data, design, cs.DM(np.asarray(state.synergy_weights, dtype=float)), chains)

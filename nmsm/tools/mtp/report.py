@@ -92,7 +92,7 @@ def moment_rms(results_dir: str | os.PathLike[str], *, synx: bool = False) -> di
 
 
 def parameters_within_bounds(state: MtpState, *, tolerance: float = 1e-6) -> bool:
-    """True when every design block lies in its bounds (tools.md §4.3)."""
+    """True when every design block lies in its bounds."""
     for block, (_, low, high) in BLOCKS.items():
         if block.endswith("_scale") and block.startswith(("optimal", "tendon")):
             continue  # absorbed into the lengths after each task

@@ -7,7 +7,7 @@ Steps (the original's ``MuscleTendonPersonalizationTool``):
 2. Muscle-Tendon Length Initialization when enabled (new l_o, l_ts, F0);
 3. each enabled MTP task in index order (IPOPT, exact derivatives); after a task the
    length scale factors are absorbed into l_o, l_ts;
-4. results written per §4.6 (:mod:`nmsm.tools.mtp.outputs`), staged, plus the settings file.
+4. results written as the original writes them (:mod:`nmsm.tools.mtp.outputs`), staged, plus the settings file.
 
 A stop (Ctrl-C) during task k+1 writes the results after task k, as step 4 would, into
 ``<results>/stopped_after_task_<k>/`` (``mtpSummary.txt`` says so) and nothing else: an
@@ -296,7 +296,7 @@ def write_results(outcome: MtpOutcome, results: ResultsDirectory, *, stopped_aft
 
 
 def write_result_files(stage: Path, outcome: MtpOutcome, note: str | None = None) -> None:
-    """The result files of ``outcome`` in the folder ``stage`` (§4.6, ``mtpSummary.txt``)."""
+    """The result files of ``outcome`` in the folder ``stage`` (the original's and ``mtpSummary.txt``)."""
     setup = outcome.setup
     trial_times = [t.time for t in outcome.data.trials]
     outputs.analysis_files(stage, outcome.data, outcome.plain, outcome.synx, trial_times)

@@ -2,7 +2,7 @@
 
 Excitations of muscles without EMG are built from synergy excitations ("commands")
 extracted from the measured channels, and every measured channel gets a small residual
-excitation from the same kind of commands (tools.md §4.5):
+excitation from the same kind of commands (docs/mtp.md):
 
 * measured EMG is normalized per channel by its maximum over all trials; per category of
   trials (``trial``: each trial; ``task``: trials whose name contains a task name;

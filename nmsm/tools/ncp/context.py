@@ -4,7 +4,7 @@
 weight blocks and every trial's muscle activations, either as CasADi expressions of the
 design variables (while building the problem) or as numpy arrays (when scoring a given
 solution, e.g. the MATLAB original's). Terms ask it for raw quantities; its reduction is
-NCP's ``raw / e / sqrt(numel)`` (tools.md §5, catalog §4): :func:`nmsm.core.reductions.mean_square`.
+NCP's ``raw / e / sqrt(numel)`` (as the original's NCP): :func:`nmsm.core.reductions.mean_square`.
 
 Array conventions: activations (P, M) per trial in NCP muscle order; moments (P, J).
 Stacked quantities are column-major vectors over trials in order.

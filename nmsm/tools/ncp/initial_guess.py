@@ -1,6 +1,6 @@
 """Starting synergies for the NCP optimization.
 
-The spec's start (every weight 0.01, every command node 1) makes all synergies of a group
+A uniform start (every weight 0.01, every command node 1) makes all synergies of a group
 identical, a symmetric point an exact-derivative optimizer never leaves (each synergy
 gets the same gradient). As the current MATLAB code does, the start here is the NMF of
 the MTP activations when a group has them:

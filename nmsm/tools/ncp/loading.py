@@ -1,6 +1,6 @@
 """From NCP settings to :class:`NcpInputs`: model, synergy groups, trials, MTP results.
 
-Reads (tools.md §5, settings-xml.md §3):
+Reads (docs/ncp.md):
 
 * the model (muscles crossing ``coordinate_list``; ForceSet groups for synergy groups,
   activation groups and normalized-fiber-length groups);
@@ -318,7 +318,7 @@ def _passive_coordinates(directory: Path, coordinates: Sequence[str]) -> list[st
 
 
 def _initialize_lengths(settings: NeuralControlPersonalizationSettings, inputs: NcpInputs) -> tuple[NcpInputs, tuple[str, ...]]:
-    """Run MTLI (tools.md §3) on the NCP muscles; keep its l_o, l_ts (F0) for muscles without MTP activations."""
+    """Run MTLI (docs/mtp.md) on the NCP muscles; keep its l_o, l_ts (F0) for muscles without MTP activations."""
     from nmsm.tools.mtp.mtli import MtliOptions, load_passive_trials, run_mtli
 
     mtli = settings.muscle_tendon_length_initialization

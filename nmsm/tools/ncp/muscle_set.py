@@ -1,11 +1,11 @@
 """Which muscles NCP models: those crossing the tracked coordinates, grouped into synergy groups.
 
 * A muscle crosses a coordinate list when it applies force and one of its path points
-  sits on the child body of a joint owning a listed coordinate (tools.md §0.4,
-  ``getMusclesFromCoordinates``).
+  sits on the child body of a joint owning a listed coordinate (the
+  original's ``getMusclesFromCoordinates``).
 * Every crossing muscle must belong to a synergy group; a synergy group's members that do
   not cross the coordinates are not modeled, and members that do not apply force are
-  dropped with a warning (tools.md §5).
+  dropped with a warning (docs/ncp.md).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""NCP result files (tools.md §5 "Outputs") and reading them back.
+"""NCP result files (docs/ncp.md) and reading them back.
 
 Written into the results folder (normalized synergies: largest weight of each vector 1):
 

@@ -1,6 +1,6 @@
 """The NCP optimization problem: synergy variables, terms, weight-sum constraints.
 
-Design variables (all >= 0, no upper bounds; tools.md §5):
+Design variables (all >= 0, no upper bounds; docs/ncp.md):
 
 * ``weights_<group>`` (S_g, M_g) for each group whose vectors are free (a group sharing
   another's vectors under bilateral symmetry has none);

@@ -79,8 +79,7 @@ def read_settings(path: str | os.PathLike[str]) -> NeuralControlPersonalizationS
 #: ``acceptable_iter`` iterations with the scaled NLP error below ``acceptable_tol``. When a
 #: group has more synergies than its activations need, equal-cost factorizations form
 #: flat directions, and IPOPT's dual infeasibility then wanders (1e-7..1e-4) at a constant
-#: objective instead of reaching ``tol`` (the example: 1000 iterations, cost constant to
-#: 8 digits from iteration ~100; with this stop 90 iterations, the same cost to 1e-10).
+#: objective instead of reaching ``tol`` (docs/developing.md, "NCP: measurements", "Stopping").
 ACCEPTABLE_STOP = {"acceptable_tol": 1e-4, "acceptable_obj_change_tol": 1e-10, "acceptable_iter": 10}
 
 

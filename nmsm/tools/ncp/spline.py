@@ -2,7 +2,7 @@
 
 NCP describes each synergy command of a trial by ``n_nodes`` values at evenly spaced
 points of the normalized cycle (0-100 %) and interpolates them with a not-a-knot cubic
-spline at the ``n_points`` data frames (tools.md §5). The interpolant is linear in the
+spline at the ``n_points`` data frames. The interpolant is linear in the
 node values, so it is one constant matrix ``B`` (n_points, n_nodes):
 
     commands (n_points, n_synergies) = B @ nodes (n_nodes, n_synergies)
@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-#: number of command nodes per synergy and trial (tools.md §5)
+#: number of command nodes per synergy and trial
 DEFAULT_NODE_COUNT = 21
 
 

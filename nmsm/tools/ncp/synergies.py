@@ -1,6 +1,6 @@
 """Synergy parameterization: groups, block-diagonal synergy vectors, commands, activations.
 
-Notation (tools.md §5): muscles are ordered group by group; group ``g`` has ``M_g``
+Notation (docs/ncp.md): muscles are ordered group by group; group ``g`` has ``M_g``
 muscles and ``S_g`` synergies. The synergy vectors form a block-diagonal weight matrix
 ``W`` (S, M) whose rows are the vectors (one block ``W_g`` (S_g, M_g) per group); the
 synergy commands of a trial are ``C`` (P, S) with P frames. Muscle activations are
@@ -23,7 +23,7 @@ import numpy as np
 
 from nmsm.tools.ncp.spline import DEFAULT_NODE_COUNT, interpolation_matrix
 
-#: every synergy vector of group ``g`` sums to ``M_g * WEIGHT_SUM_PER_MUSCLE`` (tools.md §5)
+#: every synergy vector of group ``g`` sums to ``M_g * WEIGHT_SUM_PER_MUSCLE`` (as the original)
 WEIGHT_SUM_PER_MUSCLE = 0.01
 
 
@@ -192,7 +192,7 @@ def activations(weights: Any, commands: Any) -> Any:
 def normalize_by_max_weight(
     weights: np.ndarray, commands: Sequence[np.ndarray]
 ) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
-    """Scale each synergy vector so its largest weight is one (tools.md §5 "Post").
+    """Scale each synergy vector so its largest weight is one (as the original does after the solve).
 
     ``weights`` (S, M); ``commands`` one (P, S) array per trial. Row ``s`` is divided by
     its maximum and column ``s`` of every command array multiplied by it, so activations

@@ -7,7 +7,7 @@ artifact               kind     what it is
 ``osimx``              file     the current ``.osimx`` (MTP, NCP and GCP each extend it)
 ``motion_data``        folder   full-length ``IKData``, ``IDData``, ``GRFData``, ``EMGData``,
                                 ``MAData`` of each trial on the current model (analysis stage)
-``data_directory``     folder   trials in the personalization layout (tools.md 0.2):
+``data_directory``     folder   trials in the personalization layout (docs/guide.md, section 2):
                                 ``IKData``, ``IDData``, ``EMGData``, ``GRFData``, ``MAData``
 ``mtp_results``        folder   MTP's results folder (``muscleActivations/`` for NCP)
 ``ncp_results``        folder   NCP's results (synergy weights and commands: the synergy

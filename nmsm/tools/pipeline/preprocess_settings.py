@@ -1,6 +1,6 @@
 """Settings of the preprocessing stage, ``<DataPreprocessingTool>``: full-length trials
 (the analysis stage's ``IKData``, ``IDData``, ``MAData``, ``GRFData``, ``EMGData``) split into
-the personalization tools' trials (tools.md §2).
+the personalization tools' trials (docs/preprocess.md).
 
 ::
 

@@ -1,5 +1,5 @@
 """The preprocessing stage: full-length trials cut into the personalization tools' trials
-(``<DataPreprocessingTool>``, tools.md §2: ``processRawEmgFile`` and ``splitIntoTrials``),
+(``<DataPreprocessingTool>``, docs/preprocess.md: ``processRawEmgFile`` and ``splitIntoTrials``),
 done by :mod:`nmsm.tools.preprocess`.
 
 Per full-length trial ``<name>`` and each time window ``k`` (output trial ``<name>_<k>``):

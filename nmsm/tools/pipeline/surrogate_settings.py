@@ -1,6 +1,6 @@
 """Settings of the surrogate-data stage, ``<SurrogateDataTool>``: poses sampled around a
 reference motion and their muscle analyses, the data a synergy-driven treatment fits its
-polynomial muscle surrogate to (tools.md §7, ``sampleSurrogateKinematics``).
+polynomial muscle surrogate to (docs/model.md, the original's ``sampleSurrogateKinematics``).
 
 ::
 

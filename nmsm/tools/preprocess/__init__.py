@@ -14,5 +14,5 @@
 
 Settings-file route: ``nmsm run`` on a ``<DataPreprocessingTool>`` file (the pipeline's
 stage, :mod:`nmsm.tools.pipeline.preprocess_stage`, which calls this package); the
-original has no preprocessing XML (tools.md §2).
+original has no preprocessing XML.
 """

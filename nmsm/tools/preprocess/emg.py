@@ -1,4 +1,4 @@
-"""EMG processing as the original's ``processEmg`` (tools.md §2), with MATLAB's ``filtfilt``.
+"""EMG processing as the original's ``processEmg`` (docs/preprocess.md), with MATLAB's ``filtfilt``.
 
 Chain (time on axis 0, channels on axis 1):
 

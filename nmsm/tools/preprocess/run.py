@@ -1,6 +1,6 @@
 """Preprocessing of one recording into the personalization layout (what ``nmsm preprocess`` runs).
 
-Steps (tools.md §2), each optional:
+Steps (docs/preprocess.md), each optional:
 
 1. raw EMG -> processed EMG (:func:`nmsm.tools.preprocess.emg.process_emg`);
 2. IK from markers, ID from IK (+ external loads), muscle analysis from IK, through nmsm's

@@ -3,8 +3,7 @@
 OpenSim's ``Storage`` keeps the first ``nRows`` rows when an old-style header states fewer
 rows than the file holds; the tutorial's raw EMG (``GaitTrial48_EMG.mot``: ``nRows=4000``,
 4001 rows) depends on it: the sampling rate ``n / (t_end - t_0)`` and the filters' edges
-change with the extra row (measured: 2.3e-4 vs 6e-9 max difference from the original's
-processed EMG). Sources may also be tables already in memory.
+change with the extra row (docs/preprocess.md). Sources may also be tables already in memory.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Muscle-tendon velocity from muscle-tendon length (``createMuscleTendonVelocity``, tools.md §2).
+"""Muscle-tendon velocity from muscle-tendon length (the original's ``createMuscleTendonVelocity``).
 
 Lengths (m) are low-passed (Butterworth order 4, ``cutoff`` Hz, zero phase) and
 differentiated through the natural quintic (GCV) spline; the result (m/s) is written next

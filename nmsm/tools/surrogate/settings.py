@@ -1,6 +1,6 @@
 """Surrogate settings of a synergy-driven treatment optimization (``RCNLSynergyController``).
 
-Elements read (settings-xml.md; defaults in brackets):
+Elements read (the original's settings; defaults in brackets):
 ``surrogate_model_coordinate_list`` (required), ``surrogate_model_data_directory``
 (required), ``epsilon`` [1e-4], ``surrogate_model_polynomial_degree`` [5],
 ``load_surrogate_model`` [false], ``save_surrogate_model`` [false],

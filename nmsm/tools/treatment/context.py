@@ -300,7 +300,7 @@ class GridView:
     def center_of_pressure(self, hindfoot_body: str) -> cs.MX:
         """(n, 3) modeled centre of pressure of a foot on the floor (m; y = 0): about the
         reference point P, ``x = P_x + M_z/F̂_y``, ``z = P_z - M_x/F̂_y``,
-        ``F̂_y = F_y + sign(F_y)`` (sign(0) = 1) - catalog §1.4."""
+        ``F̂_y = F_y + sign(F_y)`` (sign(0) = 1), as the original."""
         def compute(view: GridView) -> cs.MX:
             F, M_origin, P = view.foot_ground_reaction(hindfoot_body)
             M = M_origin - _cross_rows(P, F)
@@ -651,7 +651,7 @@ def _cross_rows(a: Any, b: Any) -> Any:
 
 def _cop(point: Any, force: Any, moment: Any) -> Any:
     """(n, 3) centre of pressure on y = 0 from the force and its moment about ``point``
-    (catalog §1.4: ``F̂_y = F_y + sign(F_y)``, sign(0) = 1)."""
+    (as the original: ``F̂_y = F_y + sign(F_y)``, sign(0) = 1)."""
     if isinstance(force, np.ndarray):
         fy = force[:, 1] + np.where(force[:, 1] >= 0, 1.0, -1.0)
         return np.c_[point[:, 0] + moment[:, 2] / fy, np.zeros(len(fy)), point[:, 2] - moment[:, 0] / fy]

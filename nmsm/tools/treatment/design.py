@@ -1,4 +1,4 @@
-"""Design Optimization extras (spec tools.md §11.1): static parameters and model functions.
+"""Design Optimization extras (docs/treatment.md): static parameters and model functions.
 
 ``<RCNLParameterTermSet>``: each ``<RCNLParameterTerm>`` declares a static design variable
 block named by its ``type`` (``initial_values``, ``lower_bounds``, ``upper_bounds``; one
@@ -92,7 +92,7 @@ def write_parameter_solution(stage: Path, prepared: Any, tsol: Any) -> list[Path
 
 
 def write_design_model(stage: Path, prepared: Any, tsol: Any) -> list[Path]:
-    """``<model>DesignOpt.osim`` (spec §11.1): the input model with the solution's joint-frame
+    """``<model>DesignOpt.osim``: the input model with the solution's joint-frame
     parameters written in place (the rest of the file untouched), when model functions made
     the model parametric (:mod:`nmsm.modifiers.joint_frame`)."""
     from nmsm.model.osim_writer import OsimWriter

@@ -1,4 +1,4 @@
-"""Assemble a TO/VO/DO optimal control problem (spec tools.md §8.2).
+"""Assemble a TO/VO/DO optimal control problem (docs/treatment.md, 'Formulation').
 
 Implicit dynamics: states are ``[q_s, q̇_s]`` of the ``states_coordinate_list`` followed
 by the controllers' own states (e.g. muscle activations under activation dynamics);

@@ -1,4 +1,4 @@
-"""Read a treatment problem's data folders (spec tools.md §8.1).
+"""Read a treatment problem's data folders (docs/treatment.md).
 
 ``tracked_quantities_directory``: ``IKData/<trial>`` (required), ``IDData/<trial>``,
 ``GRFData/<trial>`` (optional). ``initial_guess_directory``: optional ``IKData``/``IDData``

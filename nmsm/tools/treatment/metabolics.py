@@ -1,4 +1,4 @@
-"""Smoothed Bhargava (2004) metabolic model of Design Optimization (spec tools.md §11.2).
+"""Smoothed Bhargava (2004) metabolic model of Design Optimization (docs/treatment.md).
 
 Per muscle (activation ``a``, normalized fiber length ``l̃`` and velocity ``ṽ`` of the
 rigid-tendon Hill model, :mod:`nmsm.model.hill`; ``F0`` N, ``l_o`` m, pennation ``α`` rad,

@@ -1,4 +1,4 @@
-"""Write a treatment solution as the original does (spec tools.md §8.4), on the ``nodes`` grid.
+"""Write a treatment solution as the original does (docs/treatment.md, 'Outputs'), on the ``nodes`` grid.
 
 Files (``<trial>`` = ``trial_name``):
 

@@ -1,6 +1,6 @@
 """Defaults a treatment settings file leaves to the parser, reported once per term.
 
-The catalog (spec cost-constraint-terms.md §1.2, settings-xml.md) makes ``<max_allowable_error>``
+The original's term catalog makes ``<max_allowable_error>``
 optional with default 1, so a cost term without it is not an error; but it sets the term's
 weight (``((g - c)/e)^2``), so a term that omits it is reported, as an empty element is
 (:meth:`nmsm.core.term.Term.from_spec`).
