@@ -43,3 +43,36 @@ def test_no_constraints_no_option() -> None:
     v = problem.variable("v", np.ones(2))
     problem.add_cost("size", v)
     assert jacobian_direction_options(problem) == {}
+
+
+def _mixed() -> OptimizationProblem:
+    """Per-point blocks (many inputs, one row each: reverse) and a block whose every row
+    shares a global variable ``w`` with few inputs a row (forward)."""
+    problem = OptimizationProblem("mixed")
+    v = problem.variable("v", np.linspace(0.1, 0.9, 40))
+    w = problem.variable("w", np.array([0.5]))
+    problem.add_cost("size", cs.vertcat(v, w))
+    for block in range(4):
+        x = v[block * 10:(block + 1) * 10]
+        problem.add_constraint(f"point_{block}", cs.sum1(cs.sin(x) * x), -5.0, 5.0)
+    problem.add_constraint("lifted", v * w - cs.cos(v), -5.0, 5.0)
+    return problem
+
+
+def test_blocks_take_their_own_mode_and_the_jacobian_is_unchanged() -> None:
+    problem = _mixed()
+    options = jacobian_direction_options(problem)
+    assert set(options) == {"jac_g"}
+    g, _, _ = problem.constraint_vector()
+    x = problem.scaled_vector()
+    expected = cs.Function("j", [x, problem.parameter_vector()], [g, cs.jacobian(g, x)])
+    point = np.random.default_rng(3).normal(size=x.numel())
+    got = options["jac_g"](point, problem.parameter_values())
+    want = expected(point, problem.parameter_values())
+    np.testing.assert_array_equal(np.asarray(got[0]), np.asarray(want[0]))
+    np.testing.assert_allclose(np.asarray(cs.densify(got[1])), np.asarray(cs.densify(want[1])), rtol=1e-14,
+                               atol=1e-14)
+    default = problem.solve("ipopt", print_level=0)
+    chosen = problem.solve("ipopt", print_level=0, casadi_options=options)
+    assert default.success and chosen.success
+    np.testing.assert_allclose(chosen.x_scaled, default.x_scaled, rtol=1e-8, atol=1e-10)

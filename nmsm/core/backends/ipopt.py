@@ -45,19 +45,53 @@ def resolve_linear_solver(requested: str | None) -> str:
     return name
 
 
+def _sweeps(rows: np.ndarray, columns: np.ndarray, n_rows: int, n_columns: int) -> tuple[int, int]:
+    """(forward, reverse) sweeps of a Jacobian with non-zeros at ``rows``, ``columns``: the
+    colours of its columns and of its rows."""
+    pattern = cs.Sparsity.triplet(n_rows, n_columns, rows.tolist(), columns.tolist())
+    return pattern.uni_coloring().size2(), pattern.T.uni_coloring().size2()
+
+
 def jacobian_direction_options(problem: OptimizationProblem) -> dict[str, Any]:
-    """``nlpsol`` options that compute the constraint Jacobian with the AD mode needing
-    fewer sweeps: reverse (one sweep per colour of the rows) unless the columns need fewer
-    colours than the rows (then forward). CasADi's own choice leans to forward mode,
-    which is slow for collocation problems whose per-point functions have many inputs
-    and few outputs."""
+    """``nlpsol`` options that compute the constraint Jacobian, block by block of
+    constraints, with the AD mode needing fewer sweeps for the block: reverse (one sweep per
+    colour of its rows) unless its columns need fewer colours (then forward).
+
+    CasADi's own choice, one mode for the whole Jacobian, leans to forward mode, which is
+    slow for collocation problems whose per-point functions have many inputs and few
+    outputs; and a block whose rows all share some columns (e.g. global design variables in
+    every point's rows) needs as many reverse sweeps as rows. When every block takes the
+    same mode, only CasADi's ``ad_weight`` is set; otherwise ``jac_g`` is a Function whose
+    blocks are differentiated separately, each in its own mode."""
     g, _, _ = problem.constraint_vector()
     if g.numel() == 0:
         return {}
-    pattern = cs.jacobian_sparsity(g, problem.scaled_vector())
-    forward = pattern.uni_coloring().size2()
-    reverse = pattern.T.uni_coloring().size2()
-    return {"oracle_options": {"ad_weight": 1.0 if reverse <= forward else 0.0}}
+    x = problem.scaled_vector()
+    rows, columns = (np.asarray(v, dtype=int) for v in cs.jacobian_sparsity(g, x).get_triplet())
+    reverse_blocks, start = [], 0
+    for constraint in problem.constraints:
+        n = constraint.expression.numel()
+        inside = (rows >= start) & (rows < start + n)
+        forward, reverse = _sweeps(rows[inside] - start, columns[inside], n, x.numel())
+        reverse_blocks.append(reverse <= forward)
+        start += n
+    if all(reverse_blocks) or not any(reverse_blocks):
+        return {"oracle_options": {"ad_weight": 1.0 if reverse_blocks[0] else 0.0}}
+    parts, order = [], []
+    for wanted in (True, False):
+        chosen = [c for c, reverse in zip(problem.constraints, reverse_blocks) if reverse == wanted]
+        expression = cs.vertcat(*[c.expression for c in chosen])
+        parts.append(cs.jacobian(expression, x, {"helper_options": {"ad_weight": 1.0 if wanted else 0.0}}))
+    offsets = np.cumsum([0] + [c.expression.numel() for c in problem.constraints])
+    for wanted in (True, False):
+        order += [list(range(offsets[i], offsets[i + 1])) for i, reverse in enumerate(reverse_blocks)
+                  if reverse == wanted]
+    stacked = [row for block in order for row in block]
+    position = np.empty(len(stacked), dtype=int)
+    position[stacked] = np.arange(len(stacked))
+    jacobian = cs.vertcat(*parts)[position.tolist(), :]
+    jac_g = cs.Function("nlp_jac_g", [x, problem.parameter_vector()], [g, jacobian], ["x", "p"], ["g", "jac_g_x"])
+    return {"jac_g": jac_g}
 
 
 def solve_ipopt(
