@@ -34,8 +34,12 @@ from nmsm.examples.subject_settings import SOLVER_XML, _constraint, _relative, _
 
 #: mesh variants: (intervals, collocation points per interval)
 MESHES = {"full": (25, 4), "coarse": (5, 4)}
-#: IPOPT tolerance and iteration limit of TO/VO and of DO (Design Optimization caps at 1e-6)
-SOLVER_FILES = {"solver.xml": ("1e-3", 500), "solver_do.xml": ("1e-6", 500)}
+#: IPOPT tolerance and iteration limit of TO/VO and of DO (Design Optimization caps at 1e-6);
+#: with limited-memory Hessians (see :func:`solver_xml`) IPOPT takes more, cheaper iterations
+SOLVER_FILES = {"solver.xml": ("1e-3", 3000), "solver_do.xml": ("1e-6", 3000)}
+#: the case's Lagrangian Hessian: L-BFGS (docs/treatment.md, "Scale": the exact Hessian of
+#: the contact and muscle functions costs most of an iteration and IPOPT regularizes it heavily)
+HESSIAN = "limited-memory"
 #: tracking errors: rotations (rad), translations (m), their speeds, loads (N·m or N),
 #: ground forces (N) and moments (N·m), activations (-)
 COORDINATE_ERROR = 0.0873
@@ -110,7 +114,9 @@ def _loads(coordinates: Sequence[str]) -> str:
 def solver_xml(mesh: str, file_name: str) -> str:
     intervals, points = MESHES[mesh]
     tolerance, iterations = SOLVER_FILES[file_name]
-    return SOLVER_XML.format(tolerance=tolerance, intervals=intervals, points=points, max_iterations=iterations)
+    text = SOLVER_XML.format(tolerance=tolerance, intervals=intervals, points=points, max_iterations=iterations)
+    return text.replace("    </GpopsSettings>",
+                        f"      <hessian_approximation>{HESSIAN}</hessian_approximation>\n    </GpopsSettings>", 1)
 
 
 def _common(folders: CaseFolders, results: Path, guess: Path, tracked: Path, solver: str) -> str:

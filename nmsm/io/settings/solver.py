@@ -129,6 +129,15 @@ class GpopsSettings:
     setup_nlp_max_iterations: int = setting(
         "setup_nlp_max_iterations", kind="integer", default=20000, check=at_least_one, doc="NLP iterations"
     )
+    hessian_approximation: str = setting(
+        "hessian_approximation",
+        kind="text",
+        default="exact",
+        choices=("exact", "limited-memory"),
+        doc="nmsm's choice of IPOPT's Lagrangian Hessian: exact (second derivatives by automatic "
+            "differentiation) or limited-memory (L-BFGS from first derivatives, as GPOPS-II's first "
+            "derivative level gives IPOPT)",
+    )
     setup_display_level: int = setting(
         "setup_display_level", kind="integer", default=2, check=non_negative, doc="Solver output level"
     )

@@ -160,7 +160,7 @@ def _ipopt_kwargs(prepared: Prepared, options: TreatmentOptions, log: Path | Non
         "tol": options.tolerance or plan["tol"],
         "linear_solver": options.linear_solver or plan["linear_solver"],
         "print_level": plan["print_level"] if options.print_level is None else options.print_level,
-        "hessian": options.hessian,
+        "hessian": options.hessian or plan.get("hessian", "exact"),
         "ipopt_options": extra,
     }
 

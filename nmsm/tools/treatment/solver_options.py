@@ -65,6 +65,7 @@ def plan_from_settings(gpops: Any, *, source: str = "", max_tolerance: float = M
         "tol": tol,
         "linear_solver": str(gpops.setup_nlp_linear_solver),
         "print_level": 0 if display == 0 else (3 if display == 1 else 5),
+        "hessian": str(gpops.hessian_approximation),
     }
     ignored = []  # options set away from their defaults that nmsm cannot honour
     if gpops.setup_derivatives_supplier != "sparseFD":

@@ -50,7 +50,8 @@ class TreatmentOptions:
     Directories override the settings file's (``guess_directory`` replaces only the
     starting point: references such as the initial controls of ``controller_tracking``
     still come from ``initial_guess_directory``). IPOPT: ``max_iterations``,
-    ``tolerance``, ``hessian`` ('exact' or 'limited-memory'), ``linear_solver``,
+    ``tolerance``, ``hessian`` ('exact' or 'limited-memory'; default: the solver settings'
+    ``<hessian_approximation>``, exact unless set), ``linear_solver``,
     ``print_level``, ``ipopt_options`` (any other IPOPT option), ``objective_scaling``
     ('initial': IPOPT minimizes the objective divided by its value at the initial guess,
     clipped to [1e-6, 1e6], so ``setup_nlp_tolerance`` acts on a relative scale; 'none';
@@ -76,7 +77,7 @@ class TreatmentOptions:
     guess_directory: Path | None = None
     max_iterations: int | None = None
     tolerance: float | None = None
-    hessian: str = "exact"
+    hessian: str | None = None
     linear_solver: str | None = None
     print_level: int | None = None
     ipopt_options: dict[str, Any] = attrs.field(factory=dict)

@@ -28,3 +28,38 @@ def test_user_ipopt_options_override_the_tool_defaults() -> None:
     assert _ipopt_kwargs(_prepared("DO"), mine, None)["ipopt_options"]["mu_strategy"] == "monotone"
     warm = _ipopt_kwargs(_prepared("VO", {"states": object()}), mine, None)["ipopt_options"]
     assert warm["mu_init"] == 1e-3 and warm["bound_push"] == WARM_START_OPTIONS["bound_push"]
+
+
+def _solver_file(folder, hessian: str | None):
+    from nmsm.io.settings.reader import read_settings_document
+    from nmsm.io.settings.solver import OptimalControlSolverSettings
+
+    element = f"<hessian_approximation>{hessian}</hessian_approximation>" if hessian is not None else ""
+    path = folder / "solver.xml"
+    path.write_text(f"""<?xml version="1.0" encoding="UTF-8"?>
+<NMSMPipelineDocument Version="1.5.3"><OptimalControlSolverSettings><GpopsSettings>
+<setup_mesh_method>none</setup_mesh_method><setup_nlp_linear_solver>mumps</setup_nlp_linear_solver>
+{element}</GpopsSettings></OptimalControlSolverSettings></NMSMPipelineDocument>""", encoding="utf-8")
+    return path, OptimalControlSolverSettings.from_document(read_settings_document(path))
+
+
+def test_the_solver_file_chooses_the_hessian(tmp_path) -> None:
+    from nmsm.tools.treatment.solver_options import plan_from_settings
+
+    for hessian, expected in ((None, "exact"), ("exact", "exact"), ("limited-memory", "limited-memory")):
+        _, settings = _solver_file(tmp_path, hessian)
+        plan = plan_from_settings(settings.gpops)
+        assert plan.ipopt["hessian"] == expected
+        prepared = SimpleNamespace(tool="TO", plan=plan, files=SimpleNamespace(results={}))
+        assert _ipopt_kwargs(prepared, TreatmentOptions(), None)["hessian"] == expected
+        assert _ipopt_kwargs(prepared, TreatmentOptions(hessian="exact"), None)["hessian"] == "exact"
+
+
+def test_an_unknown_hessian_is_refused_at_its_element(tmp_path) -> None:
+    import pytest
+
+    from nmsm.errors import InputError
+
+    with pytest.raises(InputError, match="hessian_approximation") as error:
+        _solver_file(tmp_path, "bfgs")
+    assert "limited-memory" in str(error.value)
