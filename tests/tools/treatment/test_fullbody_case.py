@@ -4,7 +4,8 @@ problem builds at the expected size and its derivatives agree with finite differ
 The case is prepared quickly (``write_case(..., quick=True)``: the GCP tutorial's right foot
 and its mirror image instead of two GCP runs, 3 surrogate poses per frame); the settings
 files are the ones ``python -m nmsm.examples.fullbody write`` writes. Solving it is in the
-slow suite (``test_fullbody_solve.py``) and ``benchmarks/bench_fullbody.py``.
+slow suite (``test_fullbody_coarse_solve.py``), the ``scale`` marker (``test_fullbody_solve.py``,
+full mesh) and ``benchmarks/bench_fullbody.py``.
 """
 
 from __future__ import annotations

@@ -8,12 +8,11 @@ Checks: IPOPT succeeds in every tool; every TO tracking term's RMS is within its
 both feet's ground reactions are written; the VO reproduces the TO within 0.1 deg and
 0.1 N·m; the DO changes the paretic synergy's drive and names the terms that drove it.
 
-Today the solve does not reach IPOPT's first iteration within the caps (measured on the coarse
-mesh: no iteration after 20 min wall at 8.8 GB; docs/treatment.md "Full-body gait case"):
+Today the TO iterates (limited-memory Hessian, about 0.7 GB) but needs hundreds of
+iterations of a few CPU seconds each, longer than the cap (docs/treatment.md, "Scale"):
 running out of time or memory (an abort, a ``MemoryError``) raises :class:`TooSlowOrTooBig`,
-the expected failure. A run that ends
-inside the cap and misses a check fails; one that passes shows as a strict XPASS (remove
-the marker then).
+the expected failure. A run that ends inside the cap and misses a check fails; one that
+passes shows as a strict XPASS (remove the marker then).
 """
 
 from __future__ import annotations
@@ -53,7 +52,7 @@ def full_stress(shared_data, tmp_path_factory):
 
 @pytest.mark.scale
 @pytest.mark.xfail(raises=TooSlowOrTooBig, strict=True,
-                   reason="the full-body stress TO does not reach IPOPT's first iteration within 10 min / 12 GB")
+                   reason="the full-body stress TO -> VO -> DO chain takes longer than 10 min")
 def test_stress_chain_full_mesh(full_stress):
     repo = Path(__file__).resolve().parents[3]
     try:
