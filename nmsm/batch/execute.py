@@ -45,6 +45,17 @@ from nmsm.errors import InputError
 
 #: times the scheduler of the built-in cluster runs a run again after its worker died
 RETRIES = 1
+#: Dask settings of the built-in cluster (scheduler, nannies and workers): each CPU-second its
+#: processes spend on their own bookkeeping is taken from the solves when every core runs one.
+#: A run goes to a worker once that worker is free (none waits in a busy worker's queue while
+#: another idles); no statistical profiler sampling the running solve; event-loop health
+#: checks and the nannies' memory checks once a second.
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.scheduler.worker-saturation": 1.0,
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
 #: seconds to wait for a scheduler given with ``scheduler=`` (``--scheduler``)
 SCHEDULER_TIMEOUT = 10.0
 #: seconds between looks at the runs while waiting
@@ -154,6 +165,7 @@ def _check_folders(spec: BatchSpec, plans: list[RunPlan]) -> None:
 @contextlib.contextmanager
 def connect(workers: int | None, scheduler: str | None, timeout: float) -> Iterator[tuple[Any, int, str | None, bool]]:
     """``(client, number of workers, dashboard address or None, local)`` (module docstring, step 2)."""
+    import dask
     from distributed import Client, LocalCluster
 
     from nmsm.core.threads import THREADS_VARIABLE
@@ -174,11 +186,13 @@ def connect(workers: int | None, scheduler: str | None, timeout: float) -> Itera
         return
     count = workers or os.cpu_count() or 1
     dashboard_wanted = importlib.util.find_spec("bokeh") is not None
-    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, silence_logs=logging.ERROR,
-                           dashboard_address=":0", env={THREADS_VARIABLE: "1"},
-                           scheduler_kwargs={"allowed_failures": RETRIES, "dashboard": dashboard_wanted})
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # read when each process starts (the nannies pass it on)
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, silence_logs=logging.ERROR,
+                               dashboard_address=":0", env={THREADS_VARIABLE: "1"},
+                               scheduler_kwargs={"allowed_failures": RETRIES, "dashboard": dashboard_wanted})
     try:
-        client = Client(cluster, timeout=timeout)
+        with dask.config.set(LOCAL_CLUSTER_CONFIG):
+            client = Client(cluster, timeout=timeout)
         try:
             yield client, count, cluster.dashboard_link if dashboard_wanted else None, True
         finally:

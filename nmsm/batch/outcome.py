@@ -37,7 +37,8 @@ class RunOutcome:
     parent's solution) and ``objective_change`` the difference; ``tracking_rms``: RMS over the
     tracked coordinates of modeled minus tracked positions (deg for rotations; for a run
     warm-started from its parent and tracking it, how far the motion moved); ``wall_time``
-    (s) of the run on its worker; ``attempts``: 2 when a worker died while running it and it
+    (s) of the run on its worker and ``cpu_time`` (s), the CPU time its worker process used
+    meanwhile (the run's threads and the worker's own bookkeeping); ``attempts``: 2 when a worker died while running it and it
     ran again.
     """
 
@@ -50,6 +51,7 @@ class RunOutcome:
     initial_objective: float | None = attrs.field(default=None, converter=_number)
     tracking_rms: float | None = attrs.field(default=None, converter=_number)
     wall_time: float | None = attrs.field(default=None, converter=_number)
+    cpu_time: float | None = attrs.field(default=None, converter=_number)
     worker: str = ""
     attempts: int = 1
     warnings: tuple[str, ...] = ()

@@ -2,7 +2,7 @@
 
 One row per run: the run, its patient, sweep and variant, one column per swept parameter
 (its value), then :data:`FIGURES` (status, IPOPT status, iterations, the design goal's value
-and change from the starting point, tracking RMS, wall time, worker, attempts, results
+and change from the starting point, tracking RMS, wall and CPU time, worker, attempts, results
 folder, message). :func:`draw_sweeps` draws, for each sweep, the design goal (the final
 objective) and the tracking RMS against the first parameter, one line per value of the
 others.
@@ -21,7 +21,7 @@ from nmsm.batch.sweep import RunPlan
 SUMMARY_FILE = "batch_summary.csv"
 HEAD = ("run", "patient", "sweep", "variant")
 FIGURES = ("status", "ipopt_status", "iterations", "objective", "initial_objective", "objective_change",
-           "tracking_rms_deg", "wall_time_s", "worker", "attempts", "results_directory", "message")
+           "tracking_rms_deg", "wall_time_s", "cpu_time_s", "worker", "attempts", "results_directory", "message")
 
 
 def _g(value: float | None) -> str:
@@ -45,6 +45,7 @@ def summary_rows(plans: Sequence[RunPlan], outcomes: dict[str, RunOutcome]) -> t
             "objective": _g(outcome.objective), "initial_objective": _g(outcome.initial_objective),
             "objective_change": _g(outcome.objective_change), "tracking_rms_deg": _g(outcome.tracking_rms),
             "wall_time_s": "" if outcome.wall_time is None else f"{outcome.wall_time:.2f}",
+            "cpu_time_s": "" if outcome.cpu_time is None else f"{outcome.cpu_time:.2f}",
             "worker": outcome.worker, "attempts": str(outcome.attempts),
             "results_directory": plan.folder.relative_to(plan.results_root).as_posix(),
             "message": " ".join(outcome.message.split()),

@@ -231,7 +231,7 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
     is the outcome's message; Ctrl-C (KeyboardInterrupt) and a dying process are not caught."""
     from nmsm.tools.pipeline.hashing import DigestCache
 
-    began = time.perf_counter()
+    began, cpu_began = time.perf_counter(), time.process_time()
     address, worker = _worker()
     if worker is not None:
         worker.log_event(EVENT_TOPIC, {"run": plan.name, "pid": os.getpid(), "worker": address})
@@ -251,7 +251,8 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
     except Exception as exc:  # noqa: BLE001 - one failing run is its outcome, the batch goes on
         message = str(exc) if isinstance(exc, NmsmError) else f"{type(exc).__name__}: {exc}"
         outcome = RunOutcome(plan.name, FAILED, message=message, wall_time=time.perf_counter() - began,
-                             worker=address, attempts=attempts, warnings=tuple(caught))
+                             cpu_time=time.process_time() - cpu_began, worker=address, attempts=attempts,
+                             warnings=tuple(caught))
         if not _after_failure(plan, exc):  # the record keeps the folder the batch's (never skipped)
             _write_json(record_path(plan), {"run": plan.name, "input_digest": None,
                                             "finished": datetime.datetime.now().isoformat(timespec="seconds"),
@@ -263,7 +264,8 @@ def run_one(plan: RunPlan, digest: str | None) -> RunOutcome:
         raise
     shutil.rmtree(admin_path(plan, ".earlier"), ignore_errors=True)
     status = SKIPPED if plan.kind == "pipeline" and _all_up_to_date(result) else OK
-    outcome = RunOutcome(plan.name, status, wall_time=time.perf_counter() - began, worker=address,
+    outcome = RunOutcome(plan.name, status, wall_time=time.perf_counter() - began,
+                         cpu_time=time.process_time() - cpu_began, worker=address,
                          attempts=attempts, warnings=tuple(caught), **headline(result, plan.folder))
     _write_json(record_path(plan), {"run": plan.name, "input_digest": digest,
                                     "output_digest": DigestCache().folder(plan.folder),
