@@ -17,7 +17,12 @@
    the cluster has closed);
 4. prints the medians and the speed-up ``median wall (1 worker) / median wall (2 workers)``,
    of the runs' schedule (the cluster's start to the last result) and of the whole call
-   (``nmsm.batch.run``: starting the cluster, hashing the inputs, the summary and figures).
+   (``nmsm.batch.run``: starting the cluster, hashing the inputs, the summary and figures),
+   and for each pair the speed-up and the cores the 2-worker batch got (its processes' CPU
+   seconds over its whole call): below 2 while other processes took their share. On a
+   machine whose scheduler groups processes by session (Linux autogroup, as on the shared
+   CI machine), the batch's processes share one group's part of the cores whatever their
+   number, so 2 workers gain nothing while other sessions keep the cores busy.
 
 The VO every variant starts from is not part of the timed sweep: it is the parent run that
 a batch holding both (``nmsm example --batch``) runs once and skips on every rerun; the
@@ -73,12 +78,13 @@ def _one(sweep: Path, results: Path, workers: int) -> dict[str, float]:
                "runs": sum(runs), "n": len(runs), "load": os.getloadavg()[0], "cpu_run": statistics.median(cpu),
                "cpu_runs": sum(cpu), "cpu_client": client, "cpu_workers": workers_cpu}
     figures["overhead"] = (wall - figures["runs"]) / len(runs)
+    figures["cores"] = (client + workers_cpu) / total
     print(f"{workers} worker(s): wall {wall:.1f} s from the cluster's start to the last result (cluster start "
           f"{outcome.startup_time:.1f} s; the whole call {total:.1f} s), runs {figures['runs']:.1f} s in all "
           f"({figures['runs'] / len(runs):.1f} s each), overhead per run {figures['overhead']:.2f} s (meaningful "
           f"with 1 worker); CPU s: runs {sum(cpu):.1f} in all (median {figures['cpu_run']:.2f} a run, "
-          f"{min(cpu):.2f}-{max(cpu):.2f}), workers {workers_cpu:.1f}, client+scheduler+nannies {client:.1f}; "
-          f"load average {os.getloadavg()}", flush=True)
+          f"{min(cpu):.2f}-{max(cpu):.2f}), workers {workers_cpu:.1f}, client+scheduler+nannies {client:.1f}, cores "
+          f"used {figures['cores']:.2f} (CPU / whole call); load average {os.getloadavg()}", flush=True)
     return figures
 
 
@@ -104,6 +110,9 @@ def main(argv: list[str] | None = None) -> int:
             shutil.rmtree(target, ignore_errors=True)
             results[workers].append(_one(sweep, target, workers))
             shutil.rmtree(target, ignore_errors=True)
+    for k, (one, two) in enumerate(zip(results[1], results[2])):
+        print(f"pair {k + 1}: speed-up {one['wall'] / two['wall']:.2f}x (whole call {one['total'] / two['total']:.2f}x), "
+              f"cores used with 2 workers {two['cores']:.2f}")
     wall = {w: statistics.median(r["wall"] for r in rows) for w, rows in results.items()}
     total = {w: statistics.median(r["total"] for r in rows) for w, rows in results.items()}
     cpu = {w: statistics.median(r["cpu_run"] for r in rows) for w, rows in results.items()}

@@ -17,6 +17,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from batch_helpers import leftover_processes, sweep, write_batch  # noqa: E402
 
 from nmsm.batch import run  # noqa: E402
+from nmsm.batch.execute import LOCAL_CLUSTER_CONFIG, connect  # noqa: E402
 from nmsm.batch.summary import read_summary  # noqa: E402
 
 
@@ -54,6 +55,7 @@ def test_runs_wait_for_their_dependencies_a_broken_file_fails_alone_and_a_rerun_
     assert "knee_bounds" in columns
     assert [r["knee_bounds"] for r in rows] == ["", "", "0.2", "0.5"]
     assert all(r["iterations"] and r["objective"] and r["worker"] for r in rows if r["status"] == "ok")
+    assert all(float(r["cpu_time_s"]) > 0 for r in rows if r["status"] == "ok")
     assert (out / "plots" / "sweep_bounds.png").is_file()
     assert not leftover_processes()
 
@@ -117,4 +119,27 @@ def test_ctrl_c_keeps_the_finished_runs_and_writes_the_summary(jmp_case, tmp_pat
     _, rows = read_summary(out / "batch_summary.csv")
     assert [(r["run"], r["status"]) for r in rows] == [("base", "ok"), ("bounds/knee_bounds=0.3", "stopped")]
     assert not (out / "bounds").exists()
+    assert not leftover_processes()
+
+
+def _worker_settings() -> dict:
+    import dask
+
+    from nmsm.core.threads import SOLVER_THREADS
+
+    return {"config": {key: dask.config.get(key) for key in LOCAL_CLUSTER_CONFIG}, "solver_threads": SOLVER_THREADS,
+            "threads": {name: os.environ.get(name) for name in ("NMSM_THREADS", "OMP_NUM_THREADS",
+                                                                 "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}}
+
+
+def test_the_local_cluster_runs_single_threaded_solves_with_light_bookkeeping(time_limit) -> None:
+    time_limit(120)
+    with connect(2, None, 60) as (client, count, _, local):
+        settings = client.run(_worker_settings)
+        saturation = client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION)
+    assert count == 2 and local and len(settings) == 2
+    for worker in settings.values():
+        assert worker["config"] == LOCAL_CLUSTER_CONFIG
+        assert worker["solver_threads"] == 1 and set(worker["threads"].values()) == {"1"}, worker
+    assert saturation == LOCAL_CLUSTER_CONFIG["distributed.scheduler.worker-saturation"] == 1.0
     assert not leftover_processes()
