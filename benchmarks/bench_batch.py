@@ -111,8 +111,8 @@ def main(argv: list[str] | None = None) -> int:
             results[workers].append(_one(sweep, target, workers))
             shutil.rmtree(target, ignore_errors=True)
     for k, (one, two) in enumerate(zip(results[1], results[2])):
-        print(f"pair {k + 1}: speed-up {one['wall'] / two['wall']:.2f}x (whole call {one['total'] / two['total']:.2f}x), "
-              f"cores used with 2 workers {two['cores']:.2f}")
+        print(f"pair {k + 1}: speed-up {one['wall'] / two['wall']:.2f}x (whole call "
+              f"{one['total'] / two['total']:.2f}x), cores used with 2 workers {two['cores']:.2f}")
     wall = {w: statistics.median(r["wall"] for r in rows) for w, rows in results.items()}
     total = {w: statistics.median(r["total"] for r in rows) for w, rows in results.items()}
     cpu = {w: statistics.median(r["cpu_run"] for r in rows) for w, rows in results.items()}

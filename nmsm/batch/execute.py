@@ -7,7 +7,8 @@
 2. Connect: without ``scheduler``, a :class:`distributed.LocalCluster` of ``workers`` worker
    processes (default: one per core) with one thread each, their solves single-threaded
    (``NMSM_THREADS=1``; OpenMP/BLAS at 1 thread, Dask's default), the scheduler retrying a
-   run whose worker died once (:data:`RETRIES`); with ``scheduler``, the user's cluster at
+   run whose worker died once (:data:`RETRIES`), Dask's bookkeeping light
+   (:data:`LOCAL_CLUSTER_CONFIG`); with ``scheduler``, the user's cluster at
    that address (refused when it does not answer within ``timeout`` seconds).
 3. Submit each run once the runs it depends on finished (:func:`nmsm.batch.task.run_one` on
    a worker). A run whose inputs (settings, the contents of every file and folder they name,

@@ -38,8 +38,8 @@ class RunOutcome:
     tracked coordinates of modeled minus tracked positions (deg for rotations; for a run
     warm-started from its parent and tracking it, how far the motion moved); ``wall_time``
     (s) of the run on its worker and ``cpu_time`` (s), the CPU time its worker process used
-    meanwhile (the run's threads and the worker's own bookkeeping); ``attempts``: 2 when a worker died while running it and it
-    ran again.
+    meanwhile (the run's threads and the worker's own bookkeeping); ``attempts``: 2 when a
+    worker died while running it and it ran again.
     """
 
     name: str
