@@ -47,7 +47,7 @@ import warnings
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
-from nmsm.core.unconverged import stamp_unconverged
+from nmsm.core.unconverged_stamp import stamp_unconverged
 from nmsm.errors import InputError
 from nmsm.io.output_file import move_into_place
 
@@ -169,7 +169,7 @@ class ResultsDirectory:
         were not written again (module docstring). ``part_of_run`` False: the run's record
         (``ResultsDirectory(record=...)``) is neither begun nor extended by this task.
         ``unconverged``: the note of accepted unconverged results; every staged file is
-        stamped with it before the move (:func:`nmsm.core.unconverged.stamp_unconverged`).
+        stamped with it before the move (:func:`nmsm.core.unconverged_stamp.stamp_unconverged`).
         """
         stage = Path(tempfile.mkdtemp(prefix=f".staging-{_safe(name)}-", dir=self.ensure()))
         try:

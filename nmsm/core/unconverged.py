@@ -12,26 +12,22 @@ pipeline stops at that stage.
 
 With ``accept_unconverged=True`` (``nmsm run --accept-unconverged``, ``nmsm pipeline
 --accept-unconverged``) the results are written where they normally go, with a warning,
-and every file of the results is stamped (:func:`stamp_unconverged`): a header line
-``unconverged=...`` in ``.sto``/``.mot`` tables, an XML comment ``UNCONVERGED: ...`` after the
-declaration of ``.osim``/``.osimx``/``.xml`` files, a first line ``UNCONVERGED: ...`` in
+and every file of the results is stamped (:mod:`nmsm.core.unconverged_stamp`): a header
+line ``unconverged=...`` in ``.sto``/``.mot`` tables, an XML comment ``UNCONVERGED: ...`` after
+the declaration of ``.osim``/``.osimx``/``.xml`` files, a first line ``UNCONVERGED: ...`` in
 ``.txt``/``.log`` files and an ``"unconverged"`` entry in JSON objects. Other files (figures)
 are left as they are.
 """
 
 from __future__ import annotations
 
-import json
-import re
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
+from nmsm.core.results import ResultsDirectory
+from nmsm.core.unconverged_stamp import stamp_unconverged
 from nmsm.errors import SolverError
-
-if TYPE_CHECKING:
-    from nmsm.core.results import ResultsDirectory
 
 #: folder (inside the results folder) of an unconverged run's last iterate and diagnosis
 LAST_ITERATE = "last_iterate"
@@ -39,10 +35,6 @@ LAST_ITERATE = "last_iterate"
 DIAGNOSIS_FILE = "diagnosis.txt"
 #: the command-line option accepting unconverged results
 ACCEPT_OPTION = "--accept-unconverged"
-
-_XML_SUFFIXES = (".osim", ".osimx", ".xml")
-_TEXT_SUFFIXES = (".txt", ".log")
-_TABLE_SUFFIXES = (".sto", ".mot")
 
 
 def unconverged_note(what: Sequence[str]) -> str:
@@ -72,48 +64,6 @@ def diagnosis_text(note: str, hints: Sequence[str], details: str) -> str:
     """``diagnosis.txt``: what did not converge, what to try, then the tool's details."""
     body = "\n".join(hints) + "\n\n" if hints else ""
     return f"Diagnosis\n=========\nThe solve {note}.\n\n{body}{details.rstrip()}\n"
-
-
-def stamp_unconverged(folder: Path, note: str) -> None:
-    """Stamp every file under ``folder`` as unconverged (module docstring)."""
-    line = " ".join(note.split())
-    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
-        suffix = path.suffix.lower()
-        if suffix in _TABLE_SUFFIXES:
-            _stamp_table(path, line)
-        elif suffix in _XML_SUFFIXES:
-            _stamp_xml(path, line)
-        elif suffix in _TEXT_SUFFIXES:
-            text = path.read_text(encoding="utf-8", errors="surrogateescape")
-            path.write_text(f"UNCONVERGED: {line}\n{text}", encoding="utf-8", errors="surrogateescape")
-        elif suffix == ".json":
-            _stamp_json(path, line)
-
-
-def _stamp_table(path: Path, line: str) -> None:
-    lines = path.read_text(encoding="utf-8", errors="surrogateescape").splitlines(keepends=True)
-    end = next((i for i, text in enumerate(lines) if text.strip().lower() == "endheader"), None)
-    if end is None:
-        return
-    lines.insert(end, f"unconverged={line}\n")
-    path.write_text("".join(lines), encoding="utf-8", errors="surrogateescape")
-
-
-def _stamp_xml(path: Path, line: str) -> None:
-    text = path.read_text(encoding="utf-8", errors="surrogateescape")
-    comment = f"<!-- UNCONVERGED: {re.sub('-{2,}', '-', line).rstrip('-')} -->\n"
-    declaration = re.match(r"\s*<\?xml[^>]*\?>\s*", text)
-    at = declaration.end() if declaration else 0
-    path.write_text(text[:at] + comment + text[at:], encoding="utf-8", errors="surrogateescape")
-
-
-def _stamp_json(path: Path, line: str) -> None:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (ValueError, UnicodeDecodeError):
-        return
-    if isinstance(data, dict):
-        path.write_text(json.dumps({"unconverged": line, **data}, indent=1), encoding="utf-8")
 
 
 def write_last_iterate(results: ResultsDirectory, write: Callable[[Path], None], diagnosis: str, note: str) -> Path:

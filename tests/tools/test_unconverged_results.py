@@ -96,7 +96,7 @@ def test_an_unconverged_solve_keeps_only_its_last_iterate(shared_data: Path, tmp
 
 def test_stamped_files_read_back(tmp_path: Path) -> None:
     """Stamped tables and .osimx files are read by nmsm as before."""
-    from nmsm.core.unconverged import stamp_unconverged
+    from nmsm.core.unconverged_stamp import stamp_unconverged
     from nmsm.io.osimx import read_osimx
     from nmsm.io.storage import read_storage, table_from_columns, write_storage
 
