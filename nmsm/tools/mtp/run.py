@@ -39,7 +39,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from nmsm.core.convergence import CONVERGENCE_TABLE, ConvergenceHistory, write_convergence_table
+from nmsm.core.convergence import CONVERGENCE_TABLE, write_convergence_table
 from nmsm.core.console import announce, summarize
 from nmsm.core.results import STOPPED_FOLDER, ResultsDirectory
 from nmsm.core.registry import build_terms
@@ -47,16 +47,17 @@ from nmsm.core.term import CostTerm
 from nmsm.core.unconverged import diagnosis_text, settle, status_hints
 from nmsm.errors import InputError, SolverError
 from nmsm.io.layout import trial_table_folders
-from nmsm.io.osimx import OsimxModel, read_osimx
+from nmsm.io.osimx import read_osimx
 from nmsm.io.settings.reader import read_settings_document
 from nmsm.io.settings.mtp import MuscleTendonPersonalizationSettings, MtpTask
 from nmsm.tools.mtp import outputs
 from nmsm.tools.mtp.data import check_same_frame_counts, find_prefixes, load_trial
-from nmsm.tools.mtp.evaluation import ModeledValues, check_fiber_lengths, evaluate, initial_fiber_lengths
+from nmsm.tools.mtp.evaluation import check_fiber_lengths, evaluate, initial_fiber_lengths
 from nmsm.tools.mtp.model_info import muscle_parameters, muscles_crossing
 from nmsm.tools.mtp.mtli import MtliOptions, MtliResult, load_passive_trials, passive_moments_at, run_mtli
 from nmsm.tools.mtp.mtli_model import PassiveTrial
-from nmsm.tools.mtp.muscles import MuscleParameters, channel_map, resolve_groups
+from nmsm.tools.mtp.outcome import MtpOutcome, MtpSetup, TaskOutcome
+from nmsm.tools.mtp.muscles import channel_map, resolve_groups
 from nmsm.tools.mtp.problem import (
     MtpData,
     MtpState,
@@ -78,56 +79,6 @@ TASK_FLAGS = {
     "optimize_optimal_fiber_lengths": "optimal_fiber_length_scale",
     "optimize_tendon_slack_lengths": "tendon_slack_length_scale",
 }
-
-
-@attrs.frozen(eq=False)
-class MtpSetup:
-    """Everything read from the settings, model and data, before any optimization."""
-
-    settings: MuscleTendonPersonalizationSettings
-    model_name: str
-    input_osimx: OsimxModel | None
-    model_muscles: MuscleParameters
-    data: MtpData
-    passive_trials: tuple[PassiveTrial, ...]
-    tasks: tuple[TaskSettings, ...]
-    mtli_terms: tuple[CostTerm, ...]
-
-
-@attrs.frozen(eq=False)
-class TaskOutcome:
-    index: int
-    cost: float
-    term_costs: dict[str, float]
-    status: str
-    iterations: int
-    wall_time: float
-    history: ConvergenceHistory | None = None
-    converged: bool = True
-
-
-@attrs.frozen(eq=False)
-class MtpOutcome:
-    """Final parameters, modeled values and where results went.
-
-    ``start_data``: the data the first task started from (muscles after MTLI);
-    ``data``: with the final l_o, l_ts (scale factors absorbed, ``state`` scales are 1).
-    """
-
-    setup: MtpSetup
-    start_data: MtpData
-    data: MtpData
-    state: MtpState
-    mtli: MtliResult | None
-    tasks: tuple[TaskOutcome, ...]
-    plain: ModeledValues
-    synx: ModeledValues | None
-    results_directory: Path
-    wall_time: float
-
-    @property
-    def final_muscles(self) -> MuscleParameters:
-        return self.data.muscles
 
 
 def _log(verbose: bool, message: str) -> None:

@@ -2,14 +2,10 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
+from nmsm.tools.mtp.outcome import MtpOutcome
 from nmsm.tools.mtp.problem import BLOCKS, MtpState
-
-if TYPE_CHECKING:
-    from nmsm.tools.mtp.run import MtpOutcome
 
 #: design blocks shown when at a bound: name, factor to the shown unit, unit (the length
 #: scales are absorbed into the lengths after each task, so they are not shown)
