@@ -45,7 +45,8 @@ from typing import Any
 import numpy as np
 
 from nmsm.tools.treatment.compare import Comparison, legacy_solution_folder, max_constraint_violation, score_solution
-from nmsm.tools.treatment.run import TreatmentRun, run_settings
+from nmsm.tools.treatment.outcome import TreatmentRun
+from nmsm.tools.treatment.run import run_settings
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "treatment"
 TOY = DATA / "toy_arm"

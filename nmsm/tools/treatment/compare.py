@@ -23,7 +23,8 @@ import attrs
 import numpy as np
 
 from nmsm.core.ocp import evaluation_of
-from nmsm.tools.treatment.run import TreatmentRun, run_settings
+from nmsm.tools.treatment.outcome import TreatmentRun
+from nmsm.tools.treatment.run import run_settings
 
 
 def score_solution(settings_file: str | os.PathLike[str], solution_directory: str | os.PathLike[str],

@@ -46,26 +46,10 @@ from nmsm.core.results import SUPERSEDED, ResultsDirectory
 from nmsm.core.unconverged import ACCEPT_OPTION, status_hints, unconverged_note, warn_accepted, write_last_iterate
 from nmsm.errors import InputError, SolverError
 from nmsm.tools.treatment.diagnosis import FAR_FROM_CONSISTENT, convergence_summary, worst_constraint
+from nmsm.tools.treatment.outcome import TreatmentRun
 from nmsm.tools.treatment.solution import TreatmentSolution
+from nmsm.tools.treatment.summary import summary_lines
 from nmsm.tools.treatment.tool import Prepared, TreatmentOptions, prepare
-
-
-@attrs.define
-class TreatmentRun:
-    """What a run produced."""
-
-    prepared: Prepared
-    solution: Solution
-    result: TreatmentSolution
-    summary: str
-    initial_cost: float
-    results_directory: Path | None
-    files: list[Path]
-    build_time: float
-
-    @property
-    def cost(self) -> float:
-        return self.solution.cost
 
 
 def load_settings(path: str | os.PathLike[str]) -> tuple[Any, Any]:
@@ -250,8 +234,6 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
     try:
         run = _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
         if console_enabled():
-            from nmsm.tools.treatment.summary import summary_lines
-
             summarize(prepared.tool, summary_lines(run, problem.term_costs(x0)))
         return run
     finally:

@@ -9,12 +9,10 @@ goal (every cost term that tracks nothing) from the initial guess to the solutio
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from nmsm.tools.treatment.run import TreatmentRun
+from nmsm.tools.treatment.outcome import TreatmentRun
 
 #: term type -> (factor for rotational coordinates, unit for rotational, factor otherwise, unit otherwise)
 UNITS: dict[str, tuple[float, str, float, str]] = {

@@ -19,7 +19,8 @@ import pytest
 
 from nmsm.io.storage import read_storage
 from nmsm.tools.treatment.compare import Comparison, legacy_solution_folder, score_solution
-from nmsm.tools.treatment.run import TreatmentRun, run_settings
+from nmsm.tools.treatment.outcome import TreatmentRun
+from nmsm.tools.treatment.run import run_settings
 
 #: known RMS exceedances at a lower total cost (a different trade-off between the terms), see
 #: docs/developing.md (Treatment); any other exceedance fails
