@@ -134,7 +134,17 @@ class GridView:
         return self._q.tracked_loads(self.grid, load)
 
     def controller_load(self, load: str) -> cs.MX:
-        return self._q.controller_load(self.grid, self._q.load_coordinate(load))
+        coordinate = self._q.load_coordinate(load)
+
+        def compute() -> cs.MX:
+            total: cs.MX | None = None
+            for controller in self._q.data.controllers:
+                loads = self._q.cache((self.grid, "controller_loads", id(controller)),
+                                      lambda c=controller: c.applied_loads(self))
+                if coordinate in loads:
+                    total = loads[coordinate] if total is None else total + loads[coordinate]
+            return cs.MX(self.n, 1) if total is None else total
+        return self._q.cache((self.grid, "controller_load", coordinate), compute)
 
     def load_coordinate(self, load: str) -> str:
         """The coordinate of an ID load label (``knee_angle_r_moment`` -> ``knee_angle_r``)."""
@@ -191,8 +201,24 @@ class GridView:
         return self._q.initial_control(self.grid, name)
 
     def muscle_activations(self) -> cs.MX:
-        """(n, M) activations of :attr:`TreatmentContext.muscle_names`."""
-        return self._q.muscle_activations(self.grid)
+        """(n, M) activations of :attr:`TreatmentContext.muscle_names`: the sum of what the
+        controllers driving each muscle give it (zero for a muscle no controller drives)."""
+        def compute() -> cs.MX:
+            parts = []
+            for controller in self._q.data.controllers:
+                names = controller.muscle_names()
+                if names:
+                    parts.append((names, controller.muscle_activations(self)))
+            cols = []
+            for muscle in self._q.muscle_names:
+                col = None
+                for names, acts in parts:
+                    if muscle in names:
+                        part = acts[:, list(names).index(muscle)]
+                        col = part if col is None else col + part
+                cols.append(col if col is not None else cs.MX(self.n, 1))
+            return cs.horzcat(*cols) if cols else cs.MX(self.n, 0)
+        return self._q.cache((self.grid, "muscle_activations"), compute)
 
     def muscle_activation(self, muscle: str) -> cs.MX:
         return self.muscle_activations()[:, self._q.muscle_index(muscle)]
@@ -201,7 +227,21 @@ class GridView:
         return self._q.tracked_activation(self.grid, muscle)
 
     def normalized_fiber_length(self, muscle: str) -> cs.MX:
-        return self._q.muscle_quantity(self.grid, "normalized_fiber_length")[:, self._q.muscle_index(muscle)]
+        return self._muscle_quantity("normalized_fiber_length")[:, self._q.muscle_index(muscle)]
+
+    def _muscle_quantity(self, name: str) -> cs.MX:
+        """(n, M) Hill-model quantity ``name`` of :attr:`TreatmentContext.muscle_names`, from the
+        first controller that gives it for a muscle (zero where none does)."""
+        def compute() -> cs.MX:
+            cols = {}
+            for controller in self._q.data.controllers:
+                values = controller.muscle_quantity(self, name)
+                if values is not None:
+                    for j, m in enumerate(controller.muscle_names()):
+                        cols.setdefault(m, values[:, j])
+            names = self._q.muscle_names
+            return cs.horzcat(*[cols.get(m, cs.MX(self.n, 1)) for m in names]) if names else cs.MX(self.n, 0)
+        return self._q.cache((self.grid, "muscle_quantity", name), compute)
 
     def map_kinematics_function(self, key: Any, function: cs.Function, uses: str = "q, qd, qdd",
                                 coordinates: Any = None, extra: tuple = ()) -> list[cs.MX]:
@@ -350,8 +390,8 @@ class GridView:
             names = self._q.muscle_names
             params = self._q.cache(("metabolic_parameters",), self._metabolic_parameter_row)
             f = self._q.cache(("metabolic_function",), lambda: metabolic_point_function(len(names)))
-            (rate,) = map_rows(f, view.muscle_activations(), self._q.muscle_quantity(view.grid, "normalized_fiber_length"),
-                               self._q.muscle_quantity(view.grid, "normalized_fiber_velocity"), params,
+            (rate,) = map_rows(f, view.muscle_activations(), view._muscle_quantity("normalized_fiber_length"),
+                               view._muscle_quantity("normalized_fiber_velocity"), params,
                                parallel=self._q.parallel)
             return rate + BASAL_RATE * self.body_mass()
         return self.cached("metabolic_rate", compute)

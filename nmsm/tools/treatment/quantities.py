@@ -5,6 +5,8 @@ rows (:func:`~nmsm.core.row_map.map_rows`).
 Terms never use this class directly: they read it through the views of
 :mod:`nmsm.tools.treatment.context` (:class:`~nmsm.tools.treatment.context.GridView`,
 :class:`~nmsm.tools.treatment.context.TreatmentContext`), which document the shapes and units.
+What the controllers contribute (applied loads, muscle activations, Hill-model quantities) the
+views ask the controllers for, handing them themselves; this module computes the rest.
 """
 
 from __future__ import annotations
@@ -17,7 +19,6 @@ import numpy as np
 
 from nmsm.core.function_names import function_name
 from nmsm.core.row_map import map_rows
-from nmsm.tools.treatment.context import GridView
 from nmsm.tools.treatment.orientation import euler_angles
 from nmsm.tools.treatment.transcription.base import Trajectory
 
@@ -339,19 +340,6 @@ class ContextQuantities:
         return self.cache((grid, "tracked_load", label),
                           lambda: cs.DM(refs.values(self.reference_times(grid), 0, [label])))
 
-    def controller_load(self, grid: str, coordinate: str) -> cs.MX:
-        def compute() -> cs.MX:
-            total: cs.MX | None = None
-            view = GridView(self, grid)
-            for controller in self.data.controllers:
-                loads = self.cache((grid, "controller_loads", id(controller)), lambda c=controller: c.applied_loads(view))
-                if coordinate in loads:
-                    total = loads[coordinate] if total is None else total + loads[coordinate]
-            if total is None:
-                return cs.MX(self.trajectory.grid_size(grid), 1)
-            return total
-        return self.cache((grid, "controller_load", coordinate), compute)
-
     # ---- markers and bodies -------------------------------------------------------------------
     def _marker_functions(self, marker: str) -> cs.Function:
         def compute() -> cs.Function:
@@ -423,39 +411,6 @@ class ContextQuantities:
         controller, internal = self._lookup(name)
         return self.cache((grid, "initial_control", internal),
                           lambda: cs.DM(controller.control_reference(internal, self.reference_times(grid))))
-
-    def muscle_activations(self, grid: str) -> cs.MX:
-        def compute() -> cs.MX:
-            view = GridView(self, grid)
-            parts = []
-            for controller in self.data.controllers:
-                names = controller.muscle_names()
-                if names:
-                    parts.append((names, controller.muscle_activations(view)))
-            n = self.trajectory.grid_size(grid)
-            cols = []
-            for muscle in self.muscle_names:
-                col = None
-                for names, acts in parts:
-                    if muscle in names:
-                        part = acts[:, list(names).index(muscle)]
-                        col = part if col is None else col + part
-                cols.append(col if col is not None else cs.MX(n, 1))
-            return cs.horzcat(*cols) if cols else cs.MX(n, 0)
-        return self.cache((grid, "muscle_activations"), compute)
-
-    def muscle_quantity(self, grid: str, name: str) -> cs.MX:
-        def compute() -> cs.MX:
-            view = GridView(self, grid)
-            n = self.trajectory.grid_size(grid)
-            cols = {}
-            for controller in self.data.controllers:
-                values = controller.muscle_quantity(view, name)
-                if values is not None:
-                    for j, m in enumerate(controller.muscle_names()):
-                        cols.setdefault(m, values[:, j])
-            return cs.horzcat(*[cols.get(m, cs.MX(n, 1)) for m in self.muscle_names]) if self.muscle_names else cs.MX(n, 0)
-        return self.cache((grid, "muscle_quantity", name), compute)
 
     def tracked_activation(self, grid: str, muscle: str) -> cs.DM:
         refs = self.data.references["activations"]

@@ -355,8 +355,8 @@ def test_metabolic_rate_of_the_synergy_kick_guess(shared_data: Path) -> None:
         return np.asarray(built.problem.evaluate(cs.MX(e), x0))
 
     a = at_start(ctx.muscle_activations())
-    ln = at_start(ctx._q.muscle_quantity(ctx.grid, "normalized_fiber_length"))
-    vn = at_start(ctx._q.muscle_quantity(ctx.grid, "normalized_fiber_velocity"))
+    ln = at_start(ctx._muscle_quantity("normalized_fiber_length"))
+    vn = at_start(ctx._muscle_quantity("normalized_fiber_velocity"))
     from nmsm.model import load_model
 
     osim = load_model(folder / "KickingModel.osim")
