@@ -1,8 +1,10 @@
 """The house in layers: which package may import which, and no import loops between files.
 
 Read from the source with :mod:`ast` (nothing is imported). Every ``import`` counts, at module
-level or inside a function, because both run; imports under ``if TYPE_CHECKING:`` never run
-and are left out. Layers, lowest first (docs/architecture.md, "Layers"):
+level or inside a function, because both run. Imports under ``if TYPE_CHECKING:`` never run:
+the layer tests leave them out, the loop test counts them (two files that name each other's
+types depend on each other, whether or not the import runs). Layers, lowest first
+(docs/architecture.md, "Layers"):
 
     errors, hookspecs  <-  io  <-  core  <-  model, interop  <-  plugins  <-  tools  <-  cli, report, plots, examples
 
@@ -75,12 +77,12 @@ def _type_checking_nodes(tree: ast.AST) -> set[int]:
     return out
 
 
-def imported_names(path: pathlib.Path, module: str, is_package: bool) -> set[str]:
-    """Absolute names of everything ``path`` imports when it runs (module- and function-level):
-    ``from a.b import c`` gives ``a.b.c`` when that is a module, else ``a.b`` (see
-    :func:`import_graph`), so both are listed."""
+def imported_names(path: pathlib.Path, module: str, is_package: bool, *, type_checking: bool = False) -> set[str]:
+    """Absolute names of everything ``path`` imports when it runs (module- and function-level),
+    and with ``type_checking`` also under ``if TYPE_CHECKING:``: ``from a.b import c`` gives
+    ``a.b.c`` when that is a module, else ``a.b`` (see :func:`import_graph`), so both are listed."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    skip = _type_checking_nodes(tree)
+    skip = set() if type_checking else _type_checking_nodes(tree)
     names: set[str] = set()
     for node in ast.walk(tree):
         if id(node) in skip:
@@ -98,9 +100,11 @@ def imported_names(path: pathlib.Path, module: str, is_package: bool) -> set[str
     return names
 
 
-def import_graph(modules: dict[str, tuple[pathlib.Path, bool]]) -> dict[str, set[str]]:
-    """module -> the nmsm modules (files) it imports: ``x.y.z`` counts as the longest module
-    prefix (``from x.y import z`` is module ``x.y.z`` when it exists, else ``x.y``)."""
+def import_graph(modules: dict[str, tuple[pathlib.Path, bool]], *, type_checking: bool = False
+                 ) -> dict[str, set[str]]:
+    """module -> the nmsm modules (files) it imports (with ``type_checking``: also under ``if
+    TYPE_CHECKING:``): ``x.y.z`` counts as the longest module prefix (``from x.y import z`` is
+    module ``x.y.z`` when it exists, else ``x.y``)."""
     def resolve(name: str) -> str | None:
         while name and name not in modules:
             name = name.rpartition(".")[0]
@@ -110,7 +114,7 @@ def import_graph(modules: dict[str, tuple[pathlib.Path, bool]]) -> dict[str, set
     for module, (path, is_package) in modules.items():
         if module == "nmsm":
             continue
-        for name in imported_names(path, module, is_package):
+        for name in imported_names(path, module, is_package, type_checking=type_checking):
             if name.startswith("nmsm."):
                 target = resolve(name)
                 if target not in (None, "nmsm", module):
@@ -162,7 +166,14 @@ def layer_of(module: str) -> tuple[str, int] | None:
 
 @pytest.fixture(scope="module")
 def nmsm_graph() -> dict[str, set[str]]:
+    """The imports that run."""
     return import_graph(_module_files(ROOT / "nmsm", "nmsm"))
+
+
+@pytest.fixture(scope="module")
+def nmsm_graph_with_type_checking() -> dict[str, set[str]]:
+    """The imports that run and those under ``if TYPE_CHECKING:``."""
+    return import_graph(_module_files(ROOT / "nmsm", "nmsm"), type_checking=True)
 
 
 def _describe(graph: dict[str, set[str]], group: list[str]) -> str:
@@ -170,9 +181,10 @@ def _describe(graph: dict[str, set[str]], group: list[str]) -> str:
     return "; ".join(f"{v} -> {', '.join(sorted(w for w in graph[v] if w in members))}" for v in group)
 
 
-def test_no_import_loops_between_files(nmsm_graph: dict[str, set[str]]) -> None:
-    found = loops(nmsm_graph)
-    assert not found, "import loops:\n" + "\n".join(_describe(nmsm_graph, group) for group in found)
+def test_no_import_loops_between_files(nmsm_graph_with_type_checking: dict[str, set[str]]) -> None:
+    graph = nmsm_graph_with_type_checking
+    found = loops(graph)
+    assert not found, "import loops:\n" + "\n".join(_describe(graph, group) for group in found)
 
 
 def test_every_part_of_nmsm_has_a_layer(nmsm_graph: dict[str, set[str]]) -> None:
