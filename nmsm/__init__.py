@@ -18,7 +18,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-__version__ = "0.1.0"
+from nmsm.version import __version__
 
 __all__ = ["__version__", "run", "run_pipeline"]
 

@@ -28,6 +28,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: layer of each top-level part of nmsm (lowest 0); parts not listed are checked for loops only
 LAYERS: dict[str, int] = {
     "nmsm.errors": 0,
+    "nmsm.version": 0,
     "nmsm.hookspecs": 0,
     "nmsm.cli_types": 0,
     "nmsm.io": 1,
@@ -192,9 +193,10 @@ def test_every_part_of_nmsm_has_a_layer(nmsm_graph: dict[str, set[str]]) -> None
     assert not unplaced, f"modules outside every layer of LAYERS: {unplaced}"
 
 
-def test_no_module_imports_a_layer_above_its_own(nmsm_graph: dict[str, set[str]]) -> None:
+def test_no_module_imports_a_layer_above_its_own(nmsm_graph_with_type_checking: dict[str, set[str]]) -> None:
+    """Type annotations count: a lower layer does not even name a higher layer's types."""
     upward = []
-    for module, targets in sorted(nmsm_graph.items()):
+    for module, targets in sorted(nmsm_graph_with_type_checking.items()):
         here = layer_of(module)
         for target in sorted(targets):
             there = layer_of(target)

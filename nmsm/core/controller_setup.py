@@ -17,9 +17,9 @@ import numpy as np
 
 from nmsm.errors import InputError
 
-if TYPE_CHECKING:  # the treatment tool's types, named in annotations only
-    from nmsm.tools.treatment.model_interface import TreatmentModel
-    from nmsm.tools.treatment.references import ReferenceSplines
+if TYPE_CHECKING:  # named in annotations only
+    from nmsm.core.ocp_model import TreatmentModel
+    from nmsm.core.splines import ReferenceSplines
 
 
 @attrs.define

@@ -255,7 +255,7 @@ def leg_case() -> LegCase:
     """The files, the model adapter and the tracked data of the module docstring."""
     from nmsm.io.storage import Table
     from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
-    from nmsm.tools.treatment.references import ReferenceSplines
+    from nmsm.core.splines import ReferenceSplines
 
     folder = _folder()
     model = OsimTreatmentModel(folder / "leg.osim")

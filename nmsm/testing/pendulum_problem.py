@@ -17,7 +17,7 @@ from nmsm.examples.pendulum import Pendulum
 from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.splines import ReferenceSplines
 from nmsm.tools.treatment.transcription.mesh import Mesh
 
 #: duration of the movement (s)

@@ -107,9 +107,7 @@ def code_digest() -> str:
     other code is redone (after an upgrade, or while developing nmsm)."""
     global _CODE_DIGEST
     if _CODE_DIGEST is None:
-        import nmsm
-
-        root = Path(nmsm.__file__).resolve().parent
+        root = Path(__file__).resolve().parents[2]  # the nmsm package
         digest = hashlib.sha256()
         for file in sorted(root.rglob("*.py")):
             if file.relative_to(root).parts[0] in _NOT_RESULTS:

@@ -193,7 +193,7 @@ class PipelineState:
         self.save()
 
     def save(self) -> None:
-        from nmsm import __version__
+        from nmsm.version import __version__
 
         self.results_directory.mkdir(parents=True, exist_ok=True)
         if self.damaged is not None and self.path.is_file():

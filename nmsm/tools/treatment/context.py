@@ -68,7 +68,7 @@ from nmsm.tools.treatment.orientation import check_sequence
 if TYPE_CHECKING:
     from nmsm.core.term import ConstraintTerm, CostTerm
     from nmsm.tools.treatment.quantities import ContextQuantities
-    from nmsm.tools.treatment.model_interface import TreatmentModel
+    from nmsm.core.ocp_model import TreatmentModel
 
 
 class GridView:

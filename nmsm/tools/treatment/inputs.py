@@ -29,7 +29,7 @@ from nmsm.errors import InputError
 from nmsm.io.motion_units import warn_implausible_angles
 from nmsm.io.storage import COP_SUFFIXES, Table, read_storage
 from nmsm.io.trials import find_trial_file
-from nmsm.tools.treatment.model_interface import TreatmentModel
+from nmsm.core.ocp_model import TreatmentModel
 
 #: largest sample interval (s) of a tracked IK longer than MILLISECOND_DURATION (s): more is
 #: taken for times in milliseconds (a 0.3 s kick in ms lasts "300 s" with "5 s" frames)

@@ -14,8 +14,8 @@ import attrs
 import casadi as cs
 import numpy as np
 
-from nmsm.tools.treatment.model_interface import TreatmentModel
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.ocp_model import TreatmentModel
+from nmsm.core.splines import ReferenceSplines
 
 
 @attrs.define

@@ -26,9 +26,9 @@ from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem, speed_label
 from nmsm.tools.treatment.inputs import TreatmentFiles, duration, guess_time_problems, read_treatment_files
 from nmsm.tools.treatment.memory import MemoryEstimate, check_memory
-from nmsm.tools.treatment.model_interface import TreatmentModel
+from nmsm.core.ocp_model import TreatmentModel
 from nmsm.tools.treatment.problem_data import TreatmentData
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.splines import ReferenceSplines
 from nmsm.tools.treatment.solver_options import DESIGN_MAX_TOLERANCE, MAX_TOLERANCE, SolverPlan, plan_from_settings
 from nmsm.tools.treatment.term_defaults import default_error_warnings
 

@@ -9,7 +9,7 @@
   centre of mass (kg·m²/s), ``I_i`` the body's inertia about its own centre of mass
 
 Models: nmsm's OpenSim adapter (``model.casadi``: the tree kinematics with OpenSim generalized
-speeds), or any :class:`~nmsm.tools.treatment.model_interface.TreatmentModel` that also has
+speeds), or any :class:`~nmsm.core.ocp_model.TreatmentModel` that also has
 ``mass_properties(body) -> (mass kg, centre of mass (3,) m in the body frame, inertia (3, 3)
 kg·m² about it in body axes)``; for those, ``q̇`` must be the coordinate rates (velocities
 are ``∂/∂q · q̇`` of the body poses).

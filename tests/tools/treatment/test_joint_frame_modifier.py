@@ -27,7 +27,7 @@ from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 from nmsm.tools.treatment.modifiers import ModificationTarget
 from nmsm.tools.treatment.problem_data import TreatmentData
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.splines import ReferenceSplines
 from nmsm.tools.treatment.transcription.mesh import Mesh
 
 DURATION = 1.0

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from nmsm.errors import InputError
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.splines import ReferenceSplines
 
 
 def test_natural_quintic_reproduces_quadratics() -> None:

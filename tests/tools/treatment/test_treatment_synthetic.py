@@ -13,7 +13,7 @@ from nmsm.constraints.treatment.terminal import (
 from nmsm.terms.treatment.controllers import ControllerTracking
 from nmsm.terms.treatment.inverse_dynamics import InverseDynamicsLoadTracking
 from nmsm.terms.treatment.kinematics import GeneralizedCoordinateTracking
-from nmsm.tools.treatment.references import ReferenceSplines
+from nmsm.core.splines import ReferenceSplines
 from nmsm.tools.treatment.solution import TreatmentSolution
 
 from treatment_pendulum_case import DURATION, build_case, reference_data

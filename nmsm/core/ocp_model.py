@@ -1,4 +1,4 @@
-"""What Treatment Optimization needs from a model: per-point CasADi functions.
+"""What optimal control (Treatment Optimization) needs from a model: per-point CasADi functions.
 
 :class:`TreatmentModel` is the protocol; :mod:`nmsm.tools.treatment.model_adapter` wraps
 nmsm's OpenSim model (``nmsm.model``) in it, and tests implement it for small synthetic
