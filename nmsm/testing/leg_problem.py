@@ -245,7 +245,7 @@ class _Files:
 
 
 def _mesh() -> Any:
-    from nmsm.tools.treatment.transcription.mesh import Mesh
+    from nmsm.core.transcription.mesh import Mesh
 
     return Mesh.uniform(3, 3)
 

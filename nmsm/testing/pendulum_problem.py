@@ -18,7 +18,7 @@ from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, TreatmentProblem, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.core.splines import ReferenceSplines
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 #: duration of the movement (s)
 DURATION = 1.0

@@ -28,9 +28,9 @@ from nmsm.core.term import CostTerm, Term
 from nmsm.tools.treatment.context import TreatmentContext
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.tools.treatment.quantities import ContextQuantities
-from nmsm.tools.treatment.transcription.base import Block, FinalTime, Phase, Trajectory, Transcription
-from nmsm.tools.treatment.transcription.lgr import RadauCollocation
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.base import Block, FinalTime, Phase, Trajectory, Transcription
+from nmsm.core.transcription.lgr import RadauCollocation
+from nmsm.core.transcription.mesh import Mesh
 
 ACCEL_PREFIX = "accel:"
 

@@ -20,7 +20,7 @@ import numpy as np
 from nmsm.core.function_names import function_name
 from nmsm.core.row_map import map_rows
 from nmsm.tools.treatment.orientation import euler_angles
-from nmsm.tools.treatment.transcription.base import Trajectory
+from nmsm.core.transcription.base import Trajectory
 
 if TYPE_CHECKING:
     from nmsm.tools.treatment.problem_data import TreatmentData
@@ -127,7 +127,7 @@ class ContextQuantities:
     def collocation_derivative(self) -> cs.DM:
         """(K, K) d/ds of the per-interval polynomial through the collocation values."""
         def compute() -> cs.DM:
-            from nmsm.tools.treatment.transcription.radau import differentiation_matrix, radau_rule
+            from nmsm.core.transcription.radau import differentiation_matrix, radau_rule
 
             mesh = self.trajectory.phase.mesh
             D = np.zeros((mesh.n_collocation, mesh.n_collocation))

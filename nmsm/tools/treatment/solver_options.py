@@ -24,7 +24,7 @@ from typing import Any
 
 import attrs
 
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 
 #: loosest IPOPT ``tol`` nmsm applies (on the normalized objective)

@@ -28,7 +28,7 @@ from nmsm.tools.treatment.model_adapter import OsimTreatmentModel
 from nmsm.tools.treatment.modifiers import ModificationTarget
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.core.splines import ReferenceSplines
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 DURATION = 1.0
 TRUE_ANGLE = 0.12  # rad, elbow parent frame about its z axis (the flexion axis)

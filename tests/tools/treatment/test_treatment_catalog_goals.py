@@ -27,7 +27,7 @@ from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.metabolics import metabolic_point_function
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.core.splines import ReferenceSplines
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 from treatment_pendulum_case import DURATION, reference_data
 

@@ -1,4 +1,4 @@
-"""LGR nodes, weights and differentiation matrices (nmsm.tools.treatment.transcription.radau)."""
+"""LGR nodes, weights and differentiation matrices (nmsm.core.transcription.radau)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import casadi as cs
 import numpy as np
 import pytest
 
-from nmsm.tools.treatment.transcription.radau import differentiation_matrix, lagrange_basis_at, radau_rule
+from nmsm.core.transcription.radau import differentiation_matrix, lagrange_basis_at, radau_rule
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 10, 25, 50, 80])

@@ -27,7 +27,7 @@ from nmsm.core.controller_setup import ControllerSetup
 from nmsm.tools.treatment.formulation import StateSetup, build_problem
 from nmsm.tools.treatment.problem_data import TreatmentData
 from nmsm.core.splines import ReferenceSplines
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 from treatment_pendulum_case import DURATION, reference_data
 

@@ -8,9 +8,9 @@ import pytest
 
 from nmsm.core.problem import OptimizationProblem
 from nmsm.core.reductions import quadrature
-from nmsm.tools.treatment.transcription.base import Block, FinalTime, Phase
-from nmsm.tools.treatment.transcription.lgr import RadauCollocation
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.base import Block, FinalTime, Phase
+from nmsm.core.transcription.lgr import RadauCollocation
+from nmsm.core.transcription.mesh import Mesh
 
 
 def _double_integrator(mesh: Mesh, final_time: FinalTime) -> tuple[OptimizationProblem, object]:

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
-from nmsm.tools.treatment.transcription.radau import lagrange_basis_at, radau_rule
+from nmsm.core.transcription.radau import lagrange_basis_at, radau_rule
 
 GRIDS = ("nodes", "collocation", "initial", "final")
 

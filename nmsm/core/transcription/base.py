@@ -7,7 +7,7 @@ function, and a fixed or free final time - and hands it with an
 (``RadauCollocation``, ``TrapezoidalCollocation``). The transcription declares the
 problem's variables and defect constraints and returns a :class:`Trajectory`: the phase's
 states, controls and times as MX expressions on named grids (see
-:mod:`~nmsm.tools.treatment.transcription.mesh`), the quadrature of the cost integrals,
+:mod:`~nmsm.core.transcription.mesh`), the quadrature of the cost integrals,
 and sampling of a solution on those grids.
 """
 
@@ -22,7 +22,7 @@ import casadi as cs
 import numpy as np
 
 from nmsm.core.problem import OptimizationProblem, Solution
-from nmsm.tools.treatment.transcription.mesh import Mesh
+from nmsm.core.transcription.mesh import Mesh
 
 
 @attrs.frozen

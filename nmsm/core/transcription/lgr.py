@@ -22,8 +22,8 @@ import scipy.sparse
 
 from nmsm.core.problem import OptimizationProblem, Solution
 from nmsm.core.row_map import map_rows
-from nmsm.tools.treatment.transcription.base import Phase, Trajectory, Transcription
-from nmsm.tools.treatment.transcription.radau import radau_rule
+from nmsm.core.transcription.base import Phase, Trajectory, Transcription
+from nmsm.core.transcription.radau import radau_rule
 
 
 def _block_scale(lower: np.ndarray, upper: np.ndarray, scale: np.ndarray | None) -> np.ndarray:
