@@ -143,19 +143,9 @@ class DeGrooteMuscleModel(MuscleModel):
 
     damping: np.ndarray = attrs.field(factory=lambda: np.zeros(0))
 
-    def point_function(self) -> cs.Function:
-        if self._function is None:
-            geometry = self.surrogate.function(self.coordinates, self.muscles)
-            nc, M = len(self.coordinates), self.n
-            q, qd, a = cs.SX.sym("q", nc), cs.SX.sym("qd", nc), cs.SX.sym("a", M)
-            p = cs.SX.sym("p", 3 * M)
-            F0, lo, lts = p[:M], p[M:2 * M], p[2 * M:]
-            lengths, velocities, arms = geometry(q, qd)
-            forces, l_norm, v_norm = degroote_tendon_force(a, lengths, velocities, F0, lo, lts, cs.DM(self.pennation),
-                                                           self.vmax_factor, cs.DM(self.damping))
-            moments = cs.mtimes(arms.T, forces)
-            self._function = cs.Function("muscle_forces", [q, qd, a, p], [forces, moments, l_norm, v_norm])
-        return self._function
+    def tendon_forces(self, a: Any, lengths: Any, velocities: Any, F0: Any, lo: Any, lts: Any) -> tuple[Any, Any, Any]:
+        return degroote_tendon_force(a, lengths, velocities, F0, lo, lts, cs.DM(self.pennation), self.vmax_factor,
+                                     cs.DM(self.damping))
 
 
 class MuscleActivationController(Controller):

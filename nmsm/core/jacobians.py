@@ -12,7 +12,7 @@ A :class:`~nmsm.core.residual_problem.ResidualProblem` returns its Jacobian as o
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Any, Protocol
 
 import attrs
 import numpy as np
@@ -39,8 +39,21 @@ class Jacobian(Protocol):
         """``|J s|^2``."""
 
 
+class _MatrixProducts:
+    """``J s`` and ``|J s|²`` of a Jacobian held as ``matrix`` (numpy or scipy sparse)."""
+
+    matrix: Any
+
+    def product(self, s: np.ndarray) -> np.ndarray:
+        return np.asarray(self.matrix @ s).ravel()
+
+    def squared_norm_of_product(self, s: np.ndarray) -> float:
+        v = self.product(s)
+        return float(v @ v)
+
+
 @attrs.frozen
-class DenseJacobian:
+class DenseJacobian(_MatrixProducts):
     """A numpy Jacobian ``(m, n)``."""
 
     matrix: np.ndarray
@@ -65,16 +78,10 @@ class DenseJacobian:
             step[idx] = -np.linalg.lstsq(a, g[idx], rcond=None)[0]
         return step
 
-    def product(self, s: np.ndarray) -> np.ndarray:
-        return np.asarray(self.matrix @ s).ravel()
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.product(s)
-        return float(v @ v)
 
 
 @attrs.frozen
-class SparseJacobian:
+class SparseJacobian(_MatrixProducts):
     """A scipy sparse Jacobian ``(m, n)``."""
 
     matrix: scipy.sparse.csc_matrix
@@ -95,12 +102,6 @@ class SparseJacobian:
         step[idx] = -scipy.sparse.linalg.splu(a, permc_spec="COLAMD").solve(g[idx])
         return step
 
-    def product(self, s: np.ndarray) -> np.ndarray:
-        return np.asarray(self.matrix @ s).ravel()
-
-    def squared_norm_of_product(self, s: np.ndarray) -> float:
-        v = self.product(s)
-        return float(v @ v)
 
 
 @attrs.frozen

@@ -107,13 +107,20 @@ class MuscleModel:
             p = cs.SX.sym("p", 3 * M)
             F0, lo, lts = p[:M], p[M:2 * M], p[2 * M:]
             lengths, velocities, arms = geometry(q, qd)
-            alpha = cs.DM(self.pennation)
-            l_norm = hill.normalized_fiber_length(lengths, lo, lts, alpha)
-            v_norm = hill.normalized_fiber_velocity(velocities, lo, alpha, self.vmax_factor)
-            forces = hill.tendon_force(a, l_norm, v_norm, F0, alpha)
+            forces, l_norm, v_norm = self.tendon_forces(a, lengths, velocities, F0, lo, lts)
             moments = cs.mtimes(arms.T, forces)
             self._function = cs.Function("muscle_forces", [q, qd, a, p], [forces, moments, l_norm, v_norm])
         return self._function
+
+    def tendon_forces(self, a: Any, lengths: Any, velocities: Any, F0: Any, lo: Any, lts: Any) -> tuple[Any, Any, Any]:
+        """(tendon forces N, normalized fiber lengths, normalized fiber velocities), each (M,),
+        of activations ``a``, musculotendon lengths (m) and velocities (m/s) and the muscles'
+        maximum isometric forces ``F0`` (N), optimal fiber lengths ``lo`` and tendon slack
+        lengths ``lts`` (m): the rigid-tendon Hill model."""
+        alpha = cs.DM(self.pennation)
+        l_norm = hill.normalized_fiber_length(lengths, lo, lts, alpha)
+        v_norm = hill.normalized_fiber_velocity(velocities, lo, alpha, self.vmax_factor)
+        return hill.tendon_force(a, l_norm, v_norm, F0, alpha), l_norm, v_norm
 
     def evaluate(self, view: Any, activations: cs.MX, parallel: int = 1) -> list[cs.MX]:
         """[forces (n, M), moments (n, n_c), l̃ (n, M), ṽ (n, M)] on a grid view."""
