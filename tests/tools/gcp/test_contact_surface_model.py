@@ -17,20 +17,10 @@ from nmsm.tools.gcp.run import load_feet
 
 
 def test_matches_gcp_and_loads_are_consistent(synthetic_case):
-    settings = GroundContactPersonalizationSettings.from_document(read_settings_document(synthetic_case.settings_file))
-    foot = load_feet(settings)[0][0]
+    foot = _foot(synthetic_case)
     k = synthetic_case.spring_constants
     truth = synthetic_case.truth
-    springs = tuple(GcpSpring(n, b, tuple(loc), float(kk)) for n, b, loc, kk in
-                    zip(foot.springs.names, foot.springs.bodies, foot.springs.locations, k))
-    surface = OsimxContactSurface(
-        is_left_foot=False, belt_speed=truth.belt_speed, force_columns=("a", "b", "c"), moment_columns=("d", "e", "f"),
-        electrical_center_columns=("g", "h", "i"), hindfoot_body="calcn_r", toe_marker="R_Toe",
-        medial_marker="R_Toe_Medial", lateral_marker="R_Toe_Lateral", heel_marker="R_Heel",
-        midfoot_superior_marker="R_Midfoot_Superior", resting_spring_length=truth.resting_spring_length,
-        dynamic_friction_coefficient=truth.dynamic_friction_coefficient,
-        viscous_friction_coefficient=truth.viscous_friction_coefficient, damping_factor=truth.damping_factor,
-        latching_velocity=truth.latching_velocity, springs=springs)
+    surface = _surface(synthetic_case)
     model = load_model(synthetic_case.model_file)
     contact = ContactSurfaceModel.from_osimx(surface, model)
     assert contact.bodies == ("calcn_r", "toes_r") and contact.n_springs == k.size
@@ -63,9 +53,14 @@ def test_matches_gcp_and_loads_are_consistent(synthetic_case):
         np.testing.assert_allclose(from_loads, true_moment, rtol=1e-10, atol=1e-8)
 
 
-def _surface(synthetic_case, copies: int = 1) -> OsimxContactSurface:
+def _foot(synthetic_case):
     settings = GroundContactPersonalizationSettings.from_document(read_settings_document(synthetic_case.settings_file))
-    foot = load_feet(settings)[0][0]
+    return load_feet(settings)[0][0]
+
+
+def _surface(synthetic_case, copies: int = 1) -> OsimxContactSurface:
+    """The synthetic case's right-foot surface, its springs repeated ``copies`` times."""
+    foot = _foot(synthetic_case)
     truth = synthetic_case.truth
     springs = tuple(GcpSpring(f"{n}_{c}", b, tuple(loc), float(kk)) for c in range(copies) for n, b, loc, kk in
                     zip(foot.springs.names, foot.springs.bodies, foot.springs.locations, synthetic_case.spring_constants))
