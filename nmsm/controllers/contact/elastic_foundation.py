@@ -27,6 +27,7 @@ class ElasticFoundationContact(ContactModel):
 
     type: ClassVar[str] = "elastic_foundation"
     moment_about_floor_point: ClassVar[bool] = True
+    follows_model_parameters: ClassVar[bool] = True
 
     def __init__(self, surface: Any, model: Any, index: int) -> None:
         self.surface = ContactSurfaceModel.from_osimx(surface, model)
@@ -60,8 +61,6 @@ class ElasticFoundationContact(ContactModel):
                 raise InputError(f"contact surface {i + 1}: {exc.detail} (model {exc.file})", file=osimx.source,
                                  line=surface.line, element=exc.element, expected=exc.expected) from None
         return contacts
-
-    follows_model_parameters: ClassVar[bool] = True
 
     def belt_speed(self) -> Any:
         return self.values[CONTACT_PARAMETERS.index("belt_speed")]
