@@ -68,25 +68,20 @@ def jacobian_direction_options(problem: OptimizationProblem) -> dict[str, Any]:
         return {}
     x = problem.scaled_vector()
     rows, columns = (np.asarray(v, dtype=int) for v in cs.jacobian_sparsity(g, x).get_triplet())
-    reverse_blocks, start = [], 0
-    for constraint in problem.constraints:
-        n = constraint.expression.numel()
-        inside = (rows >= start) & (rows < start + n)
-        forward, reverse = _sweeps(rows[inside] - start, columns[inside], n, x.numel())
+    offsets = np.cumsum([0] + [c.expression.numel() for c in problem.constraints])
+    reverse_blocks = []
+    for start, end in zip(offsets[:-1], offsets[1:]):
+        inside = (rows >= start) & (rows < end)
+        forward, reverse = _sweeps(rows[inside] - start, columns[inside], end - start, x.numel())
         reverse_blocks.append(reverse <= forward)
-        start += n
     if all(reverse_blocks) or not any(reverse_blocks):
         return {"oracle_options": {"ad_weight": 1.0 if reverse_blocks[0] else 0.0}}
-    parts, order = [], []
+    parts, stacked = [], []
     for wanted in (True, False):
-        chosen = [c for c, reverse in zip(problem.constraints, reverse_blocks) if reverse == wanted]
-        expression = cs.vertcat(*[c.expression for c in chosen])
+        chosen = [i for i, reverse in enumerate(reverse_blocks) if reverse == wanted]
+        expression = cs.vertcat(*[problem.constraints[i].expression for i in chosen])
         parts.append(cs.jacobian(expression, x, {"helper_options": {"ad_weight": 1.0 if wanted else 0.0}}))
-    offsets = np.cumsum([0] + [c.expression.numel() for c in problem.constraints])
-    for wanted in (True, False):
-        order += [list(range(offsets[i], offsets[i + 1])) for i, reverse in enumerate(reverse_blocks)
-                  if reverse == wanted]
-    stacked = [row for block in order for row in block]
+        stacked += [row for i in chosen for row in range(offsets[i], offsets[i + 1])]
     position = np.empty(len(stacked), dtype=int)
     position[stacked] = np.arange(len(stacked))
     jacobian = cs.vertcat(*parts)[position.tolist(), :]

@@ -16,6 +16,7 @@ Named grids (row sets of the transcribed trajectory):
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import attrs
 import numpy as np
@@ -129,27 +130,25 @@ class Mesh:
     def state_interpolation(self, s: Sequence[float] | np.ndarray) -> np.ndarray:
         """(len(s), K + 1) matrix interpolating node values (states) at normalized times ``s``
         with each interval's degree ``n_i`` Lagrange polynomial."""
-        s = np.atleast_1d(np.asarray(s, dtype=float))
-        out = np.zeros((s.size, self.n_nodes))
-        which = self._interval_of(s)
-        starts = self.interval_starts
-        for i in np.unique(which):
-            sel = which == i
-            tau = 2.0 * (s[sel] - starts[i]) / self.fractions[i] - 1.0
-            idx = self.interval_node_indices(i)
-            out[np.ix_(np.flatnonzero(sel), idx)] = lagrange_basis_at(radau_rule(self.points[i]).nodes, tau)
-        return out
+        return self._interpolation(s, self.n_nodes, lambda i: (self.interval_node_indices(i),
+                                                               radau_rule(self.points[i]).nodes))
 
     def control_interpolation(self, s: Sequence[float] | np.ndarray) -> np.ndarray:
         """(len(s), K) matrix interpolating collocation values (controls) at ``s`` with each
         interval's degree ``n_i - 1`` Lagrange polynomial on its collocation points."""
+        return self._interpolation(s, self.n_collocation, lambda i: (self.interval_node_indices(i)[:-1],
+                                                                     radau_rule(self.points[i]).collocation))
+
+    def _interpolation(self, s: Sequence[float] | np.ndarray, n_columns: int, basis: Any) -> np.ndarray:
+        """(len(s), n_columns) Lagrange interpolation at ``s``; ``basis(i)`` gives interval
+        ``i``'s (columns, interpolation points on [-1, 1])."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
-        out = np.zeros((s.size, self.n_collocation))
+        out = np.zeros((s.size, n_columns))
         which = self._interval_of(s)
         starts = self.interval_starts
         for i in np.unique(which):
             sel = which == i
             tau = 2.0 * (s[sel] - starts[i]) / self.fractions[i] - 1.0
-            idx = self.interval_node_indices(i)[:-1]
-            out[np.ix_(np.flatnonzero(sel), idx)] = lagrange_basis_at(radau_rule(self.points[i]).collocation, tau)
+            columns, points = basis(i)
+            out[np.ix_(np.flatnonzero(sel), columns)] = lagrange_basis_at(points, tau)
         return out
