@@ -18,6 +18,8 @@ def _run(args: argparse.Namespace) -> int:
         options["results_directory"] = args.results_directory
     if args.accept_unconverged:
         options["accept_unconverged"] = True
+    if args.start_from:
+        options["guess_directory"] = args.start_from
     outcome = run_settings_file(args.settings, **options)
     where = outcome if isinstance(outcome, Path) else getattr(outcome, "results_directory", None)
     if where is not None:  # every tool says where its results went (some print nothing else)
@@ -101,6 +103,12 @@ def register(subparsers: Any) -> None:
         help="write the results of a solve that did not reach its stopping criterion where results go, each file "
              "stamped UNCONVERGED (default: its last iterate and a diagnosis go into RESULTS/last_iterate/ and nmsm "
              "exits with status 1)",
+    )
+    p.add_argument(
+        "--start-from", metavar="DIR",
+        help="treatment optimization: start IPOPT from the results in DIR (states, controls, synergy weights; e.g. "
+             "the same settings' results on a coarser mesh) instead of the settings' initial guess; the tracked "
+             "data and references stay the settings' own",
     )
     p.set_defaults(func=_run)
 

@@ -36,12 +36,13 @@ def test_treatment_run_prints_its_start_line_and_summary(shared_data: Path, tmp_
                         "5 mesh intervals, 202 variables, 150 constraint rows, 2 cost terms")
     summary = out[out.index("nmsm TO summary:"):].splitlines()
     assert re.fullmatch(r"  IPOPT Solve_Succeeded after \d+ iterations, [\d.]+ s; objective \S+ -> \S+", summary[1])
-    assert summary[2] == "  tracking RMS (largest term of each group):"
-    assert re.fullmatch(r"    generalized_coordinate_tracking +\S+ deg +"
-                        r"\(generalized_coordinate_tracking:r_elbow_flex; "
-                        r"1 term\(s\)\)", summary[3]), summary[3]
-    assert re.fullmatch(r"    inverse_dynamics_load_tracking +\S+ N·m +\(inverse_dynamics_load_tracking:"
-                        r"r_elbow_flex_moment; 1 term\(s\)\)", summary[4]), summary[4]
+    assert summary[2] == "  tracking RMS (of each group the term furthest from its max_allowable_error):"
+    assert re.fullmatch(r"    generalized_coordinate_tracking +\S+ deg +\(\S+ x max_allowable_error; "
+                        r"generalized_coordinate_tracking:r_elbow_flex; "
+                        r"0 of 1 term\(s\) above theirs\)", summary[3]), summary[3]
+    assert re.fullmatch(r"    inverse_dynamics_load_tracking +\S+ N·m +\(\S+ x max_allowable_error; "
+                        r"inverse_dynamics_load_tracking:r_elbow_flex_moment; 0 of 1 term\(s\) above theirs\)",
+                        summary[4]), summary[4]
     assert re.fullmatch(r"  constraint violation: largest \S+ \(\w+\); 0 of 2 block\(s\) above 0.0001", summary[5])
     assert summary[6] == f"nmsm: results in {tmp_path / 'to'}"
 

@@ -46,3 +46,28 @@ def thread_map(function: cs.Function, n: int, *, shared: Collection[int] = (), t
     arguments = [cs.repmat(x, 1, n) if i in shared else x for i, x in enumerate(inputs)]
     return cs.Function(name or f"{function.name()}_map", inputs, mapped.call(arguments),
                        function.name_in(), function.name_out())
+
+
+#: environment variables with which a user chooses the BLAS threads themselves
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+
+
+def limit_solver_blas_threads(threads: int = 1) -> int | None:
+    """Set the threads of the BLAS that CasADi's IPOPT and MUMPS use (CasADi's bundled
+    OpenBLAS, not numpy's) to ``threads``, unless one of :data:`BLAS_THREAD_VARIABLES` is set;
+    returns the number of threads it now has, or None where that BLAS is not found.
+
+    Its worker threads wait for work by spinning, on the same cores as the threads of
+    :func:`thread_map`, so with more than one each factorization of MUMPS costs system time
+    (the measurements: docs/developing.md, "Full-body case").
+    """
+    import ctypes
+    from pathlib import Path
+
+    library = Path(cs.__file__).parent / "libcasadi-tp-openblas.so.0"
+    if not library.is_file():
+        return None
+    blas = ctypes.CDLL(str(library))
+    if not any(os.environ.get(name, "").strip() for name in BLAS_THREAD_VARIABLES):
+        blas.openblas_set_num_threads(int(threads))
+    return int(blas.openblas_get_num_threads())

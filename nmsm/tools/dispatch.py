@@ -26,6 +26,10 @@ TOOL_RUNNERS: dict[str, str] = {
 }
 
 
+#: tools whose runs take ``guess_directory`` (``nmsm run --start-from``)
+TREATMENT_TOOLS: frozenset[str] = frozenset({
+    "TrackingOptimizationTool", "VerificationOptimizationTool", "DesignOptimizationTool"})
+
 #: tools that solve an optimization: the ones ``accept_unconverged`` applies to
 SOLVING_TOOLS: frozenset[str] = frozenset({
     "JointModelPersonalizationTool", "MuscleTendonPersonalizationTool", "NeuralControlPersonalizationTool",
@@ -64,6 +68,9 @@ def run_settings_file(settings_file: str | Path, **options: Any) -> Any:
             file=settings_file,
             expected="one of " + ", ".join(f"<{t}>" for t in TOOL_RUNNERS),
         )
+    if options.get("guess_directory") is not None and tag not in TREATMENT_TOOLS:
+        raise InputError(f"--start-from is for treatment optimization settings, not <{tag}>", file=settings_file,
+                         expected="a <" + ">, <".join(sorted(TREATMENT_TOOLS)) + "> settings file")
     if not options.get("accept_unconverged", True) or (tag not in SOLVING_TOOLS and tag != "PipelineTool"):
         options.pop("accept_unconverged", None)  # a tool without a solve has nothing to accept
     module_name, func_name = target.split(":")

@@ -49,3 +49,46 @@ def test_thread_map_derivatives_include_the_shared_input() -> None:
     a, b = jacobians(rng.normal(size=(3, n)), rng.normal(size=2))
     assert np.abs(np.array(b)[:, -2:]).max() > 0.1  # the shared input's columns are not empty
     np.testing.assert_allclose(np.array(a), np.array(b), rtol=0, atol=1e-14)
+
+
+# ---- the BLAS of CasADi's IPOPT and MUMPS (limit_solver_blas_threads) -----------------------
+@pytest.fixture
+def casadi_blas():
+    import ctypes
+    from pathlib import Path
+
+    library = Path(cs.__file__).parent / "libcasadi-tp-openblas.so.0"
+    if not library.is_file():
+        pytest.skip("this CasADi build has no bundled OpenBLAS")
+    blas = ctypes.CDLL(str(library))
+    before = blas.openblas_get_num_threads()
+    yield blas
+    blas.openblas_set_num_threads(before)
+
+
+def test_solver_blas_on_one_thread_unless_the_user_chose(casadi_blas, monkeypatch) -> None:
+    from nmsm.core.threads import BLAS_THREAD_VARIABLES, limit_solver_blas_threads
+
+    for name in BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    casadi_blas.openblas_set_num_threads(2)
+    assert limit_solver_blas_threads() == 1
+    assert casadi_blas.openblas_get_num_threads() == 1
+    casadi_blas.openblas_set_num_threads(2)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
+    assert limit_solver_blas_threads() == 2
+    assert casadi_blas.openblas_get_num_threads() == 2
+
+
+def test_an_ipopt_solve_runs_its_blas_on_one_thread(casadi_blas, monkeypatch) -> None:
+    from nmsm.core.problem import OptimizationProblem
+    from nmsm.core.threads import BLAS_THREAD_VARIABLES
+
+    for name in BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    casadi_blas.openblas_set_num_threads(2)
+    prob = OptimizationProblem()
+    x = prob.variable("x", np.zeros(3), lower=-1, upper=1)
+    prob.add_cost("fit", x - 0.5)
+    assert prob.solve("ipopt", print_level=0).success
+    assert casadi_blas.openblas_get_num_threads() == 1

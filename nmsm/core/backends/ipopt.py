@@ -19,6 +19,7 @@ from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import SolveInterrupted, interrupt_after_solve
 from nmsm.core.solution import Solution
+from nmsm.core.threads import limit_solver_blas_threads
 from nmsm.core.progress import SolveProgress, solve_progress
 
 if TYPE_CHECKING:
@@ -132,6 +133,7 @@ def solve_ipopt(
     opts["iteration_callback"] = callback  # progress lines when IPOPT is silent; the last iterate for a stop
     opts.update(casadi_options or {})
     solver = cs.nlpsol(function_name(problem.name or "nlp"), "ipopt", nlp, opts)
+    limit_solver_blas_threads()
     lo, hi = problem.bounds_scaled()
     x0 = problem.initial_scaled() if initial_guess is None else np.asarray(initial_guess, dtype=float)
     x0 = np.clip(x0, lo, hi)

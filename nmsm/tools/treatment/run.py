@@ -105,9 +105,20 @@ def objective_scaling_factor(options: TreatmentOptions, initial_cost: float) -> 
     return float(min(max(1.0 / initial_cost, 1e-6), 1e6))
 
 
-#: IPOPT options that keep it at a starting point that already solves the problem
+#: IPOPT options that keep it near a starting point that is a previous solution: a small
+#: barrier parameter and the start moved at most 1e-9 into the bounds' interior
 WARM_START_OPTIONS = {"mu_init": 1e-6, "bound_push": 1e-9, "bound_frac": 1e-9, "slack_bound_push": 1e-9,
                       "slack_bound_frac": 1e-9}
+
+#: added to :data:`WARM_START_OPTIONS` when that start satisfies every constraint: a smaller
+#: barrier parameter and bound multipliers ``mu / slack`` instead of 1, so the start's
+#: complementarity is ``mu`` and IPOPT stops where it starts if the start is optimal (with
+#: multipliers of 1, a variable away from its bounds keeps it iterating)
+FEASIBLE_START_OPTIONS = {"mu_init": 1e-9, "bound_mult_init_method": "mu-based"}
+
+#: largest constraint violation (scaled units, as :func:`worst_constraint`) of a start that
+#: counts as satisfying every constraint
+FEASIBLE_START = 1e-8
 
 
 #: IPOPT options of Design Optimization: the adaptive barrier update, which reaches lower
@@ -124,11 +135,14 @@ def warm_start_wanted(prepared: Prepared, options: TreatmentOptions) -> bool:
 
 
 def _ipopt_kwargs(prepared: Prepared, options: TreatmentOptions, log: Path | None,
-                  initial_cost: float = 1.0) -> dict[str, Any]:
+                  initial_cost: float = 1.0, start_violation: float = float("inf")) -> dict[str, Any]:
+    """IPOPT's options of the run; ``start_violation``: the starting point's largest
+    constraint violation (scaled units)."""
     plan = dict(prepared.plan.ipopt)
     extra = dict(options.ipopt_options)
     if warm_start_wanted(prepared, options):
-        for key, value in WARM_START_OPTIONS.items():
+        warm = WARM_START_OPTIONS | (FEASIBLE_START_OPTIONS if start_violation <= FEASIBLE_START else {})
+        for key, value in warm.items():
             extra.setdefault(key, value)
     if prepared.tool == "DO":
         for key, value in DESIGN_OPTIONS.items():
@@ -232,7 +246,9 @@ def run_settings(path: str | os.PathLike[str], **options: Any) -> TreatmentRun:
     # the IPOPT log is written into a hidden folder of this run, removed however the run ends
     log_dir = Path(tempfile.mkdtemp(prefix=".ipopt-", dir=results.ensure())) if results is not None else None
     try:
-        run = _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time)
+        start_violation = 0.0 if worst is None else worst.violation
+        run = _solve_and_write(path, settings, prepared, opts, results, log_dir, initial_cost, build_time,
+                               start_violation)
         if console_enabled():
             summarize(prepared.tool, summary_lines(run, problem.term_costs(x0)))
         return run
@@ -255,7 +271,7 @@ def _not_finite(solution: Solution) -> str:
 
 def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prepared, opts: TreatmentOptions,
                      results: ResultsDirectory | None, log_dir: Path | None, initial_cost: float,
-                     build_time: float) -> TreatmentRun:
+                     build_time: float, start_violation: float = float("inf")) -> TreatmentRun:
     """Solve; write the results (recorded under the trial name), or on failure the last
     iterate, after moving the earlier run's results of the trial into ``superseded/``."""
     trial = settings.trial_name
@@ -263,7 +279,7 @@ def _solve_and_write(path: str | os.PathLike[str], settings: Any, prepared: Prep
     try:
         problem = prepared.built.problem
         solution = problem.solve("ipopt", casadi_options=jacobian_direction_options(problem),
-                                 **_ipopt_kwargs(prepared, opts, log, initial_cost))
+                                 **_ipopt_kwargs(prepared, opts, log, initial_cost, start_violation))
     except SolveInterrupted as stop:
         if results is not None and stop.solution is not None:
             saved = _write_stopped(prepared, stop.solution, trial, results, log)

@@ -1,8 +1,10 @@
 """The console summary of a Tracking, Verification or Design Optimization run.
 
 IPOPT's outcome and the objective; per group of tracking terms (one group per term type)
-the largest RMS over the collocation points of a term's raw error and the term it belongs
-to; the largest constraint violation; for Design Optimization the change of each design
+the term whose RMS error over the collocation points is largest against its
+``max_allowable_error``, that RMS in the term's unit and as a multiple of its
+``max_allowable_error``, and how many terms of the group are above theirs; the largest
+constraint violation; for Design Optimization the change of each design
 goal (every cost term that tracks nothing) from the initial guess to the solution.
 """
 
@@ -10,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import attrs
 import numpy as np
 
 from nmsm.tools.treatment.outcome import TreatmentRun
@@ -47,21 +50,39 @@ def _scale(run: TreatmentRun, term_type: str, label: str) -> tuple[float, str]:
     return factor_r, unit_r
 
 
-def tracking_groups(run: TreatmentRun) -> dict[str, tuple[int, float, str, str]]:
-    """Term type -> (number of terms, largest RMS in the shown unit, unit, label of that term)
-    for every ``*_tracking`` term of the run that is evaluated over time."""
+@attrs.frozen
+class TrackingGroup:
+    """The tracking terms of one type: how many, how many end above their
+    ``max_allowable_error``, and the one furthest above it (its RMS error in ``unit``)."""
+
+    count: int
+    above: int
+    worst_rms: float
+    worst_ratio: float
+    unit: str
+    worst_label: str
+
+
+def tracking_groups(run: TreatmentRun) -> dict[str, TrackingGroup]:
+    """Term type -> :class:`TrackingGroup` for every ``*_tracking`` term of the run that is
+    evaluated over time; a term's error is its raw quantity minus its ``error_center``."""
     ctx = run.prepared.built.context
-    out: dict[str, tuple[int, float, str, str]] = {}
+    out: dict[str, TrackingGroup] = {}
     for term in run.prepared.terms:
         if not term.type.endswith("_tracking") or getattr(term, "discrete", False):
             continue
-        values = np.asarray(run.result.value(term.quantity(ctx)), dtype=float)
+        values = np.asarray(run.result.value(term.quantity(ctx)), dtype=float) - float(term.error_center)
+        rms = float(np.sqrt(np.mean(values**2)))
+        ratio = rms / float(term.max_allowable_error)
         factor, unit = _scale(run, term.type, term.label)
-        rms = factor * float(np.sqrt(np.mean(values**2)))
-        count, worst, _, worst_label = out.get(term.type, (0, -1.0, unit, ""))
-        if rms > worst:
-            worst, worst_label = rms, term.label
-        out[term.type] = (count + 1, worst, unit, worst_label)
+        group = out.get(term.type)
+        above = int(ratio > 1.0)
+        if group is None:
+            out[term.type] = TrackingGroup(1, above, factor * rms, ratio, unit, term.label)
+        elif ratio > group.worst_ratio:
+            out[term.type] = TrackingGroup(group.count + 1, group.above + above, factor * rms, ratio, unit, term.label)
+        else:
+            out[term.type] = attrs.evolve(group, count=group.count + 1, above=group.above + above)
     return out
 
 
@@ -85,9 +106,10 @@ def summary_lines(run: TreatmentRun, initial_costs: Mapping[str, float]) -> list
              f"objective {run.initial_cost:.6g} -> {solution.cost:.6g}"]
     groups = tracking_groups(run)
     if groups:
-        lines.append("tracking RMS (largest term of each group):")
-        for kind, (count, worst, unit, label) in groups.items():
-            lines.append(f"  {kind:<36s} {worst:10.4g} {unit:<6s} ({label}; {count} term(s))")
+        lines.append("tracking RMS (of each group the term furthest from its max_allowable_error):")
+        for kind, g in groups.items():
+            lines.append(f"  {kind:<36s} {g.worst_rms:10.4g} {g.unit:<6s} ({g.worst_ratio:.2g} x max_allowable_error; "
+                         f"{g.worst_label}; {g.above} of {g.count} term(s) above theirs)")
     violations = [c for c in solution.constraints if np.isfinite(c.max_violation)]
     if violations:
         worst = max(violations, key=lambda c: c.max_violation)

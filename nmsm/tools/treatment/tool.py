@@ -208,9 +208,27 @@ def _state_setup(settings: Any, files: TreatmentFiles, guess_files: TreatmentFil
     accel_splines = _guess_splines(guess_files, "accelerations", states)
     if accel_splines is not None:
         accel_guess = accel_splines.values(t_col)
+        lo_a, hi_a = _covering(lo_a, hi_a, accel_guess)
     else:
         accel_guess = ReferenceSplines.from_table(guess_files.initial_ik, states).values(t_col, 2)
+    if state_splines is not None:
+        lo_v, hi_v = _covering(lo_v, hi_v, guess[:, len(states):])
     return StateSetup(np.r_[lo_q, lo_v], np.r_[hi_q, hi_v], lo_a, hi_a, guess, accel_guess)
+
+
+#: where a previous result leaves the bounds, they are moved past it by this fraction of
+#: the widened range, so that no variable starts on a bound
+COVER_MARGIN = 0.1
+
+
+def _covering(lower: np.ndarray, upper: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds (n,) widened to cover each column of ``values`` (m, n): a previous result's own
+    speeds and accelerations, which the splined derivatives of its positions (the tracked
+    data the bounds come from) do not always bound. Positions are not widened: a guess's
+    positions outside their bounds are reported instead."""
+    low, high = values.min(axis=0), values.max(axis=0)
+    margin = COVER_MARGIN * (np.maximum(upper, high) - np.minimum(lower, low))
+    return np.where(low < lower, low - margin, lower), np.where(high > upper, high + margin, upper)
 
 
 def memory_estimate(data: TreatmentData, mesh: Any) -> MemoryEstimate:

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from nmsm.tools.treatment.run import DESIGN_OPTIONS, WARM_START_OPTIONS, _ipopt_kwargs
+from nmsm.tools.treatment.run import (DESIGN_OPTIONS, FEASIBLE_START, FEASIBLE_START_OPTIONS, WARM_START_OPTIONS,
+                                      _ipopt_kwargs)
 from nmsm.tools.treatment.tool import TreatmentOptions
 
 PLAN = {"max_iter": 500, "tol": 1e-4, "linear_solver": "mumps", "print_level": 0}
@@ -28,6 +29,20 @@ def test_user_ipopt_options_override_the_tool_defaults() -> None:
     assert _ipopt_kwargs(_prepared("DO"), mine, None)["ipopt_options"]["mu_strategy"] == "monotone"
     warm = _ipopt_kwargs(_prepared("VO", {"states": object()}), mine, None)["ipopt_options"]
     assert warm["mu_init"] == 1e-3 and warm["bound_push"] == WARM_START_OPTIONS["bound_push"]
+
+
+def test_a_verification_from_a_feasible_start_can_stop_where_it_starts() -> None:
+    """Bound multipliers mu/slack and a smaller mu only when the start satisfies every
+    constraint; from an infeasible one the plain warm start."""
+    vo = _prepared("VO", {"states": object()})
+    feasible = _ipopt_kwargs(vo, TreatmentOptions(), None, start_violation=FEASIBLE_START / 10)["ipopt_options"]
+    assert feasible["bound_mult_init_method"] == "mu-based" and feasible["mu_init"] == FEASIBLE_START_OPTIONS["mu_init"]
+    assert feasible["bound_push"] == WARM_START_OPTIONS["bound_push"]
+    infeasible = _ipopt_kwargs(vo, TreatmentOptions(), None, start_violation=0.3)["ipopt_options"]
+    assert "bound_mult_init_method" not in infeasible and infeasible["mu_init"] == WARM_START_OPTIONS["mu_init"]
+    tracking = _ipopt_kwargs(_prepared("TO", {"states": object()}), TreatmentOptions(), None,
+                             start_violation=0.0)["ipopt_options"]
+    assert "bound_mult_init_method" not in tracking and "mu_init" not in tracking
 
 
 def _solver_file(folder, hessian: str | None):
