@@ -111,9 +111,9 @@ WARM_START_OPTIONS = {"mu_init": 1e-6, "bound_push": 1e-9, "bound_frac": 1e-9, "
                       "slack_bound_frac": 1e-9}
 
 #: added to :data:`WARM_START_OPTIONS` when that start satisfies every constraint: a smaller
-#: barrier parameter and bound multipliers ``mu / slack`` instead of 1, so the start's
-#: complementarity is ``mu`` and IPOPT stops where it starts if the start is optimal (with
-#: multipliers of 1, a variable away from its bounds keeps it iterating)
+#: barrier parameter and bound multipliers ``mu / slack`` in place of IPOPT's constant ones, so
+#: the start's complementarity is ``mu`` and IPOPT stops where it starts if the start is
+#: optimal (with constant multipliers, a variable away from its bounds keeps it iterating)
 FEASIBLE_START_OPTIONS = {"mu_init": 1e-9, "bound_mult_init_method": "mu-based"}
 
 #: largest constraint violation (scaled units, as :func:`worst_constraint`) of a start that
