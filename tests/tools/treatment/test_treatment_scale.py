@@ -64,7 +64,7 @@ def test_the_worst_constraint_row_of_a_start_names_its_state_and_point(shared_da
 
 
 def test_ctrl_c_keeps_the_last_iterate_and_a_diagnosis(shared_data: Path, tmp_path: Path,
-                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+                                                       monkeypatch: pytest.MonkeyPatch, default_sigint) -> None:
     original = backend._IterateCallback.eval
 
     def stop_at_third(self, arg):  # a SIGINT arriving during iteration 3
