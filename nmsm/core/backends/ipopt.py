@@ -18,9 +18,9 @@ from nmsm.core.backends.base import Backend
 from nmsm.core.convergence import ConvergenceHistory
 from nmsm.core.function_names import function_name
 from nmsm.core.interrupts import SolveInterrupted, interrupt_after_solve
+from nmsm.core.progress import SolveProgress, solve_progress
 from nmsm.core.solution import Solution
 from nmsm.core.threads import limit_solver_blas_threads
-from nmsm.core.progress import SolveProgress, solve_progress
 
 if TYPE_CHECKING:
     from nmsm.core.problem import OptimizationProblem

@@ -53,7 +53,8 @@ def _scale(run: TreatmentRun, term_type: str, label: str) -> tuple[float, str]:
 @attrs.frozen
 class TrackingGroup:
     """The tracking terms of one type: how many, how many end above their
-    ``max_allowable_error``, and the one furthest above it (its RMS error in ``unit``)."""
+    ``max_allowable_error``, and the one whose RMS error is the largest multiple of its
+    ``max_allowable_error`` (that RMS in ``unit``, and the multiple)."""
 
     count: int
     above: int
