@@ -1,9 +1,13 @@
-"""How many threads nmsm's parallel CasADi evaluations use, and a map that keeps to them."""
+"""How many threads nmsm's parallel CasADi evaluations use, a map that keeps to them, and the
+threads of the BLAS under IPOPT's linear solves."""
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import os
 from collections.abc import Collection
+from pathlib import Path
 
 import casadi as cs
 
@@ -61,13 +65,16 @@ def limit_solver_blas_threads(threads: int = 1) -> int | None:
     :func:`thread_map`, so with more than one each factorization of MUMPS costs system time
     (the measurements: docs/developing.md, "Full-body case").
     """
-    import ctypes
-    from pathlib import Path
-
-    library = Path(cs.__file__).parent / "libcasadi-tp-openblas.so.0"
-    if not library.is_file():
+    blas = _casadi_blas()
+    if blas is None:
         return None
-    blas = ctypes.CDLL(str(library))
     if not any(os.environ.get(name, "").strip() for name in BLAS_THREAD_VARIABLES):
         blas.openblas_set_num_threads(int(threads))
     return int(blas.openblas_get_num_threads())
+
+
+@functools.lru_cache(maxsize=1)
+def _casadi_blas() -> ctypes.CDLL | None:
+    """CasADi's bundled OpenBLAS (loaded once), or None where this CasADi build has none."""
+    library = Path(cs.__file__).parent / "libcasadi-tp-openblas.so.0"
+    return ctypes.CDLL(str(library)) if library.is_file() else None

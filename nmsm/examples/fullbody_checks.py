@@ -27,7 +27,7 @@ TRANSLATIONS = ("pelvis_tx", "pelvis_ty", "pelvis_tz")
 
 def tracking_errors(run: Any) -> dict[str, tuple[float, float]]:
     """``label -> (RMS, max_allowable_error)`` of every continuous tracking term."""
-    from nmsm.tools.treatment.compare import tracking_rms
+    from nmsm.tools.treatment.summary import tracking_rms
 
     rms = tracking_rms(run)
     limits = {t.label: float(t.max_allowable_error) for t in run.prepared.terms if t.label in rms}

@@ -26,9 +26,9 @@ TOOL_RUNNERS: dict[str, str] = {
 }
 
 
-#: tools whose runs take ``guess_directory`` (``nmsm run --start-from``)
-TREATMENT_TOOLS: frozenset[str] = frozenset({
-    "TrackingOptimizationTool", "VerificationOptimizationTool", "DesignOptimizationTool"})
+#: tools whose runs take ``guess_directory`` (``nmsm run --start-from``): the treatment tools
+TREATMENT_TOOLS: frozenset[str] = frozenset(
+    tag for tag, target in TOOL_RUNNERS.items() if target == TOOL_RUNNERS["TrackingOptimizationTool"])
 
 #: tools that solve an optimization: the ones ``accept_unconverged`` applies to
 SOLVING_TOOLS: frozenset[str] = frozenset({

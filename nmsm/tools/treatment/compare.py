@@ -5,8 +5,8 @@ term, constraint violations - at the solution stored in a results folder (its
 ``<trial>_states.sto``, ``_accelerations.sto``, controls, synergy weights), without
 solving. References (tracked data, initial controls) stay those of the settings file.
 
-:func:`tracking_rms` gives, per tracking term, the RMS over the collocation points of its
-raw quantity (e.g. q_exp - q in rad, τ_exp - τ in N·m).
+:func:`tracking_rms` (:mod:`nmsm.tools.treatment.summary`'s) gives, per tracking term, the RMS
+over the collocation points of its error (e.g. q_exp - q in rad, τ_exp - τ in N·m).
 
 :func:`legacy_solution_folder` writes a schema-0.1.0 solution (``statesSolution.sto``,
 ``controlSolution.sto`` of the 2023 toy-arm examples) in the current results layout, so it
@@ -22,9 +22,9 @@ from typing import Any
 import attrs
 import numpy as np
 
-from nmsm.core.ocp import evaluation_of
 from nmsm.tools.treatment.outcome import TreatmentRun
 from nmsm.tools.treatment.run import run_settings
+from nmsm.tools.treatment.summary import tracking_rms
 
 
 def score_solution(settings_file: str | os.PathLike[str], solution_directory: str | os.PathLike[str],
@@ -67,17 +67,6 @@ def legacy_solution_folder(states_file: str | os.PathLike[str], controls_file: s
         torques[c] = controls.column(label)
     write_storage(target / f"{trial}_torqueControls.sto", table_from_columns(controls.time, torques))
     return target
-
-
-def tracking_rms(run: TreatmentRun) -> dict[str, float]:
-    """RMS (over collocation points) of each ``*_tracking`` term's raw quantity."""
-    ctx = run.prepared.built.context
-    out = {}
-    for term in run.prepared.terms:
-        if term.type.endswith("_tracking") and evaluation_of(term) != "discrete":
-            values = run.result.value(term.quantity(ctx))
-            out[term.label] = float(np.sqrt(np.mean(values**2)))
-    return out
 
 
 #: RMS below which a tracking error counts as matched (issue 8): 0.05 deg, 0.5 N·m

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 import attrs
 import numpy as np
 
+from nmsm.core.ocp import evaluation_of
 from nmsm.tools.treatment.outcome import TreatmentRun
 
 #: term type -> (factor for rotational coordinates, unit for rotational, factor otherwise, unit otherwise)
@@ -64,26 +65,33 @@ class TrackingGroup:
     worst_label: str
 
 
-def tracking_groups(run: TreatmentRun) -> dict[str, TrackingGroup]:
-    """Term type -> :class:`TrackingGroup` for every ``*_tracking`` term of the run that is
-    evaluated over time; a term's error is its raw quantity minus its ``error_center``."""
+def tracking_rms(run: TreatmentRun) -> dict[str, float]:
+    """Term label -> RMS over the collocation points of the term's error, its raw quantity
+    minus its ``error_center`` (e.g. q_exp - q in rad, τ_exp - τ in N·m), for every
+    ``*_tracking`` term of the run that is evaluated over time."""
     ctx = run.prepared.built.context
+    out = {}
+    for term in run.prepared.terms:
+        if term.type.endswith("_tracking") and evaluation_of(term) != "discrete":
+            values = np.asarray(run.result.value(term.quantity(ctx)), dtype=float) - float(term.error_center)
+            out[term.label] = float(np.sqrt(np.mean(values**2)))
+    return out
+
+
+def tracking_groups(run: TreatmentRun) -> dict[str, TrackingGroup]:
+    """Term type -> :class:`TrackingGroup` of the terms of :func:`tracking_rms`."""
+    rms = tracking_rms(run)
     out: dict[str, TrackingGroup] = {}
     for term in run.prepared.terms:
-        if not term.type.endswith("_tracking") or getattr(term, "discrete", False):
+        if term.label not in rms:
             continue
-        values = np.asarray(run.result.value(term.quantity(ctx)), dtype=float) - float(term.error_center)
-        rms = float(np.sqrt(np.mean(values**2)))
-        ratio = rms / float(term.max_allowable_error)
-        factor, unit = _scale(run, term.type, term.label)
-        group = out.get(term.type)
-        above = int(ratio > 1.0)
-        if group is None:
-            out[term.type] = TrackingGroup(1, above, factor * rms, ratio, unit, term.label)
-        elif ratio > group.worst_ratio:
-            out[term.type] = TrackingGroup(group.count + 1, group.above + above, factor * rms, ratio, unit, term.label)
-        else:
-            out[term.type] = attrs.evolve(group, count=group.count + 1, above=group.above + above)
+        ratio = rms[term.label] / float(term.max_allowable_error)
+        group = out.get(term.type, TrackingGroup(0, 0, float("nan"), -1.0, "", ""))
+        if ratio > group.worst_ratio:
+            factor, unit = _scale(run, term.type, term.label)
+            group = attrs.evolve(group, worst_rms=factor * rms[term.label], worst_ratio=ratio, unit=unit,
+                                 worst_label=term.label)
+        out[term.type] = attrs.evolve(group, count=group.count + 1, above=group.above + int(ratio > 1.0))
     return out
 
 
